@@ -1,0 +1,147 @@
+/**
+ * @file softpack_solver.h
+ * @brief The only door from the C core into the C++/Trilinos glue.
+ *
+ * Plain C, an opaque handle, error codes, no Trilinos types. Every entry point
+ * catches every exception and returns a code; the message is kept in the
+ * handle (sp_solver_last_error).
+ *
+ * The unknowns follow a layout (src/layout.h): pairs (cell, node), numbered
+ * node-major, two unknowns per pair: state[2p] = c, state[2p+1] = mu.
+ */
+#ifndef SOFTPACK_SOLVER_H
+#define SOFTPACK_SOLVER_H
+
+#include <mpi.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SP_MAX_NEWTON_HISTORY 64
+
+/** Jacobian of the element residual. */
+enum { SP_SOLVER_JAC_AD = 0, SP_SOLVER_JAC_HAND = 1, SP_SOLVER_JAC_FD = 2 };
+/** Direct linear solver. */
+enum {
+  SP_SOLVER_SUPERLU = 0,
+  SP_SOLVER_SUPERLU_DIST = 1,
+  SP_SOLVER_MUMPS = 2,
+  SP_SOLVER_KLU2 = 3
+};
+
+typedef struct sp_solver_s *sp_solver;
+
+typedef struct {
+  int jacobian;        /**< SP_SOLVER_JAC_* */
+  int linear;          /**< SP_SOLVER_SUPERLU, ... */
+  double newton_rtol;  /**< ||F|| <= rtol ||F_0|| ... */
+  double newton_atol;  /**< ... or ||F|| <= atol (unscaled 2-norm) */
+  int newton_max_its;  /**< more iterations count as a failure */
+} sp_solver_options;
+
+/** The mesh, borrowed (must outlive the solver's use of it). */
+typedef struct {
+  int n_nodes, n_elems;
+  const double *xy;       /**< 2 * n_nodes */
+  const int *elem;        /**< 4 * n_elems, counterclockwise */
+  const int *region;      /**< per element, 0 = Omega, 1 = buffer ring */
+} sp_mesh_view;
+
+/** The layout, borrowed; copied by sp_solver_set_problem. */
+typedef struct {
+  int n_nodes, n_cells, n_pairs;
+  const int *node_start;  /**< n_nodes + 1 */
+  const int *pair_cell;   /**< n_pairs */
+} sp_layout_view;
+
+/** Model parameters (MODEL.md). */
+typedef struct {
+  double alpha, kappa, lambda, lambda_b, mobility;
+} sp_model_params;
+
+/**
+ * Explicit shape-penalty data of one cell (MODEL.md, shape penalty): the term
+ * adds -sum_i coef_i * (v_i . Ibar(X) v_i) to mu_k, Ibar about (xc, yc).
+ */
+typedef struct {
+  double xc, yc;
+  double v[2][2];  /**< unit eigenvectors v_1 (larger moment), v_2 */
+  double coef[2];  /**< 2 delta^i (I^i,ref - I^i) */
+} sp_shape_coef;
+
+/** What one backward-Euler step needs besides the state. */
+typedef struct {
+  double dt;
+  sp_model_params model;
+  const double *state_old;  /**< c^n (and mu^n) in layout order */
+  const double *source;     /**< per pair: nodal source s_k (NULL: none) */
+  const sp_shape_coef *shape; /**< per cell (NULL: no shape term) */
+} sp_step_data;
+
+/** What a step did. */
+typedef struct {
+  int converged;        /**< 1 only if Newton met its tolerance */
+  int newton_its;
+  int n_residuals;      /**< entries of residual_norms */
+  double residual_norms[SP_MAX_NEWTON_HISTORY]; /**< ||F|| per iteration */
+  double t_assembly;    /**< seconds: residual + Jacobian fills */
+  double t_factor;      /**< seconds: LU factorisations */
+  double t_solve;       /**< seconds: triangular solves */
+  double t_total;       /**< seconds: the whole step */
+  char reason[160];     /**< why it failed (empty when converged) */
+} sp_step_report;
+
+/** Energy parts (MODEL.md); shape is added by the C core. */
+typedef struct {
+  double bulk, gradient, repulsion, buffer;
+} sp_energy_parts;
+
+/** @brief Create a solver on @p comm with @p options. */
+int sp_solver_create(MPI_Comm comm, const sp_solver_options *options,
+                     sp_solver *out);
+
+/** @brief (Re)build maps, graph and matrix for a mesh and layout. Cheap to
+ *         call again with the same layout; a new layout rebuilds everything. */
+int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh,
+                          const sp_layout_view *layout);
+
+/**
+ * @brief One backward-Euler step by Newton. On entry @p state is the initial
+ *        guess; on success it holds the new state. On failure it is restored
+ *        to its value on entry and report->reason says why.
+ * @return 0 on success, 1 if Newton did not converge (retry with smaller
+ *         dt), other codes for hard errors
+ */
+int sp_solver_step(sp_solver s, const sp_step_data *data, double *state,
+                   sp_step_report *report);
+
+/** @brief Energy parts of a state. */
+int sp_solver_energy(sp_solver s, const sp_model_params *model,
+                     const double *state, sp_energy_parts *parts);
+
+/**
+ * @brief Residual of the step equations at @p state (layout order, length
+ *        2 n_pairs); a test and tooling hook.
+ */
+int sp_solver_residual(sp_solver s, const sp_step_data *data,
+                       const double *state, double *residual);
+
+/**
+ * @brief Compare the element Jacobian of kind @p jacobian with a central
+ *        finite-difference one at @p state: largest |J - J_fd| / max|J_fd|
+ *        over all elements.
+ */
+int sp_solver_check_jacobian(sp_solver s, const sp_step_data *data,
+                             const double *state, int jacobian,
+                             double *max_rel_err);
+
+/** @brief The message of the last failed call on @p s. */
+const char *sp_solver_last_error(sp_solver s);
+
+void sp_solver_destroy(sp_solver *s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

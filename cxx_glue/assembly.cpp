@@ -1,0 +1,318 @@
+#include "assembly.hpp"
+
+#include <Epetra_FECrsGraph.h>
+#include <Epetra_FEVector.h>
+#include <Sacado_No_Kokkos.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sp {
+
+// Per-element scratch: the element's unknowns and step inputs, slot-major.
+struct Assembly::Gathered {
+  int n_cells = 0;
+  std::vector<double> u, c_old, source;
+  std::vector<int> dof;  // global DOF of each element unknown, -1 if absent
+  std::vector<const sp_shape_coef *> shape;
+  ElementInputs inputs(const sp_step_data &d) const {
+    ElementInputs in;
+    in.c_old = c_old.data();
+    in.source = d.source ? source.data() : nullptr;
+    in.shape = d.shape ? shape.data() : nullptr;
+    in.dt = d.dt;
+    in.model = d.model;
+    return in;
+  }
+};
+
+Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
+                   const sp_layout_view &layout)
+    : comm_(comm), n_nodes_(layout.n_nodes), n_pairs_(layout.n_pairs),
+      n_cells_(layout.n_cells),
+      node_start_(layout.node_start, layout.node_start + layout.n_nodes + 1),
+      pair_cell_(layout.pair_cell, layout.pair_cell + layout.n_pairs) {
+  if (mesh.n_nodes != layout.n_nodes)
+    throw std::runtime_error("layout and mesh disagree on the node count");
+  // Node partition: contiguous node ranges in rank order, so each rank's
+  // DOFs are a contiguous range too (what SuperLU_DIST needs).
+  const int P = comm.NumProc(), r = comm.MyPID();
+  const long first_node = (long)n_nodes_ * r / P, end_node = (long)n_nodes_ * (r + 1) / P;
+  std::vector<int> my_dofs;
+  for (long i = first_node; i < end_node; ++i)
+    for (int p = node_start_[i]; p < node_start_[i + 1]; ++p) {
+      my_dofs.push_back(2 * p);
+      my_dofs.push_back(2 * p + 1);
+    }
+  map_.reset(new Epetra_Map(-1, (int)my_dofs.size(), my_dofs.data(), 0, comm));
+
+  // Elements: geometry, cells present (union over the nodes), pairs.
+  geometry_.resize(mesh.n_elems);
+  elem_start_.assign(1, 0);
+  for (int e = 0; e < mesh.n_elems; ++e) {
+    const int *nodes = mesh.elem + 4 * e;
+    ElementGeometry &g = geometry_[e];
+    double xy[4][2];
+    for (int a = 0; a < 4; ++a) {
+      xy[a][0] = mesh.xy[2 * nodes[a]];
+      xy[a][1] = mesh.xy[2 * nodes[a] + 1];
+    }
+    for (int q = 0; q < SP_Q1_QPOINTS; ++q)
+      if (sp_q1_point(xy, q, g.N[q], g.dNdx[q], g.x[q], &g.w[q]) <= 0)
+        throw std::runtime_error("mesh element " + std::to_string(e) +
+                                 " is inverted or degenerate");
+    g.buffer = mesh.region && mesh.region[e] == 1;
+    std::vector<int> cells;
+    for (int a = 0; a < 4; ++a)
+      for (int p = node_start_[nodes[a]]; p < node_start_[nodes[a] + 1]; ++p)
+        cells.push_back(pair_cell_[p]);
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    for (int k : cells) {
+      slot_cell_.push_back(k);
+      for (int a = 0; a < 4; ++a)
+        slot_pair_.push_back(sp_layout_pair_of(k, nodes[a]));
+    }
+    elem_start_.push_back((int)slot_cell_.size());
+    if (nodes[0] >= first_node && nodes[0] < end_node) my_elems_.push_back(e);
+  }
+
+  // Graph: within an element, coupled() entries between present unknowns.
+  Epetra_FECrsGraph graph(Copy, *map_, 0);
+  Gathered scratch;
+  for (int e : my_elems_) {
+    const int nc = n_cells_on(e), s0 = elem_start_[e];
+    for (int j = 0; j < nc; ++j)
+      for (int a = 0; a < 4; ++a) {
+        int p = slot_pair_[4 * (s0 + j) + a];
+        if (p < 0) continue;
+        for (int f = 0; f < 2; ++f) {
+          std::vector<int> cols;
+          for (int j2 = 0; j2 < nc; ++j2)
+            for (int b = 0; b < 4; ++b) {
+              int p2 = slot_pair_[4 * (s0 + j2) + b];
+              if (p2 < 0) continue;
+              for (int f2 = 0; f2 < 2; ++f2)
+                if (coupled(j, f, j2, f2)) cols.push_back(2 * p2 + f2);
+            }
+          int row = 2 * p + f;
+          if (graph.InsertGlobalIndices(1, &row, (int)cols.size(), cols.data()) < 0)
+            throw std::runtime_error("graph insertion failed");
+        }
+      }
+  }
+  if (graph.GlobalAssemble() != 0) throw std::runtime_error("graph assembly failed");
+  graph_.reset(new Epetra_CrsGraph(graph));
+}
+
+// Binary search of (cell, node) in the copied layout (pairs sorted by cell).
+int Assembly::sp_layout_pair_of(int cell, int node) const {
+  auto first = pair_cell_.begin() + node_start_[node];
+  auto last = pair_cell_.begin() + node_start_[node + 1];
+  auto it = std::lower_bound(first, last, cell);
+  return (it != last && *it == cell) ? (int)(it - pair_cell_.begin()) : -1;
+}
+
+bool Assembly::same_layout(const sp_layout_view &l) const {
+  return l.n_nodes == n_nodes_ && l.n_pairs == n_pairs_ && l.n_cells == n_cells_ &&
+         std::equal(node_start_.begin(), node_start_.end(), l.node_start) &&
+         std::equal(pair_cell_.begin(), pair_cell_.end(), l.pair_cell);
+}
+
+void Assembly::gather(int e, const sp_step_data &d, const double *state,
+                      Gathered &g) const {
+  const int nc = n_cells_on(e), s0 = elem_start_[e];
+  g.n_cells = nc;
+  g.u.assign(8 * nc, 0.0);
+  g.c_old.assign(4 * nc, 0.0);
+  g.source.assign(4 * nc, 0.0);
+  g.dof.assign(8 * nc, -1);
+  g.shape.assign(nc, nullptr);
+  for (int j = 0; j < nc; ++j) {
+    if (d.shape) g.shape[j] = &d.shape[slot_cell_[s0 + j]];
+    for (int a = 0; a < 4; ++a) {
+      int p = slot_pair_[4 * (s0 + j) + a];
+      if (p < 0) continue;  // outside the support: c = mu = 0, no unknown
+      for (int f = 0; f < 2; ++f) {
+        g.u[(4 * j + a) * 2 + f] = state[2 * p + f];
+        g.dof[(4 * j + a) * 2 + f] = 2 * p + f;
+      }
+      g.c_old[4 * j + a] = d.state_old[2 * p];
+      if (d.source) g.source[4 * j + a] = d.source[p];
+    }
+  }
+}
+
+namespace {
+
+// Forward AD of the element residual with Fad type F.
+template <class F>
+void ad_element(const ElementGeometry &geo, int nc, const double *u,
+                const ElementInputs &in, double *R, double *K) {
+  const int n = 8 * nc;
+  std::vector<F> uf(n), Rf(n);
+  for (int i = 0; i < n; ++i) uf[i] = F(n, i, u[i]);
+  element_residual(geo, nc, uf.data(), in, Rf.data());
+  for (int i = 0; i < n; ++i) {
+    R[i] = Rf[i].val();
+    for (int j = 0; j < n; ++j) K[i * n + j] = Rf[i].dx(j);
+  }
+}
+
+// Central finite differences of the element residual.
+void fd_element(const ElementGeometry &geo, int nc, const double *u0,
+                const ElementInputs &in, double *R, double *K) {
+  const int n = 8 * nc;
+  std::vector<double> u(u0, u0 + n), Rp(n), Rm(n);
+  element_residual(geo, nc, u.data(), in, R);
+  for (int j = 0; j < n; ++j) {
+    const double h = 1e-5 * std::max(1.0, std::fabs(u0[j]));
+    u[j] = u0[j] + h;
+    element_residual(geo, nc, u.data(), in, Rp.data());
+    u[j] = u0[j] - h;
+    element_residual(geo, nc, u.data(), in, Rm.data());
+    u[j] = u0[j];
+    for (int i = 0; i < n; ++i) K[i * n + j] = (Rp[i] - Rm[i]) / (2 * h);
+  }
+}
+
+}  // namespace
+
+void Assembly::element_matrix(int e, const sp_step_data &d, const Gathered &g,
+                              int kind, double *R, double *K) const {
+  const ElementInputs in = g.inputs(d);
+  const ElementGeometry &geo = geometry_[e];
+  const int nc = g.n_cells;
+  const double *u = g.u.data();
+  if (kind == SP_SOLVER_JAC_FD) {
+    fd_element(geo, nc, u, in, R, K);
+    return;
+  }
+  if (kind == SP_SOLVER_JAC_HAND)
+    throw std::runtime_error("the hand-derived Jacobian is not built yet: use solver.jacobian: ad or fd");
+  // Statically sized Fad for the element sizes that occur most (1-4 cells
+  // on an element), dynamically sized beyond.
+  switch (nc) {
+    case 1: ad_element<Sacado::Fad::SFad<double, 8>>(geo, nc, u, in, R, K); break;
+    case 2: ad_element<Sacado::Fad::SFad<double, 16>>(geo, nc, u, in, R, K); break;
+    case 3: ad_element<Sacado::Fad::SFad<double, 24>>(geo, nc, u, in, R, K); break;
+    case 4: ad_element<Sacado::Fad::SFad<double, 32>>(geo, nc, u, in, R, K); break;
+    default: ad_element<Sacado::Fad::DFad<double>>(geo, nc, u, in, R, K); break;
+  }
+}
+
+void Assembly::residual(const sp_step_data &d, const double *state,
+                        Epetra_Vector &F) const {
+  Epetra_FEVector fe(*map_);
+  Gathered g;
+  std::vector<double> R;
+  std::vector<int> rows;
+  std::vector<double> vals;
+  for (int e : my_elems_) {
+    gather(e, d, state, g);
+    const int n = 8 * g.n_cells;
+    R.assign(n, 0.0);
+    element_residual(geometry_[e], g.n_cells, g.u.data(), g.inputs(d), R.data());
+    rows.clear();
+    vals.clear();
+    for (int i = 0; i < n; ++i)
+      if (g.dof[i] >= 0) {
+        rows.push_back(g.dof[i]);
+        vals.push_back(R[i]);
+      }
+    fe.SumIntoGlobalValues((int)rows.size(), rows.data(), vals.data());
+  }
+  if (fe.GlobalAssemble(Add) != 0) throw std::runtime_error("residual assembly failed");
+  F = *fe(0);
+}
+
+void Assembly::jacobian(const sp_step_data &d, const double *state, int kind,
+                        Epetra_FECrsMatrix &J) const {
+  J.PutScalar(0.0);
+  Gathered g;
+  std::vector<double> R, K, vals;
+  std::vector<int> cols;
+  for (int e : my_elems_) {
+    gather(e, d, state, g);
+    const int nc = g.n_cells, n = 8 * nc;
+    R.assign(n, 0.0);
+    K.assign((size_t)n * n, 0.0);
+    element_matrix(e, d, g, kind, R.data(), K.data());
+    for (int i = 0; i < n; ++i) {
+      if (g.dof[i] < 0) continue;
+      const int j = i / 8, f = i % 2;
+      cols.clear();
+      vals.clear();
+      for (int i2 = 0; i2 < n; ++i2)
+        if (g.dof[i2] >= 0 && coupled(j, f, i2 / 8, i2 % 2)) {
+          cols.push_back(g.dof[i2]);
+          vals.push_back(K[(size_t)i * n + i2]);
+        }
+      int rc = J.SumIntoGlobalValues(g.dof[i], (int)cols.size(), vals.data(), cols.data());
+      if (rc < 0) throw std::runtime_error("Jacobian entry outside the graph");
+    }
+  }
+  if (J.GlobalAssemble(false, Add, true) != 0)
+    throw std::runtime_error("Jacobian assembly failed");
+}
+
+sp_energy_parts Assembly::energy(const sp_model_params &m, const double *state) const {
+  double local[4] = {0, 0, 0, 0};  // bulk, gradient, repulsion, buffer
+  for (int e : my_elems_) {
+    const ElementGeometry &geo = geometry_[e];
+    const int nc = n_cells_on(e), s0 = elem_start_[e];
+    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+      double sum_sq = 0, sum_4 = 0;
+      for (int j = 0; j < nc; ++j) {
+        double c = 0, gx = 0, gy = 0;
+        for (int a = 0; a < 4; ++a) {
+          int p = slot_pair_[4 * (s0 + j) + a];
+          double ca = p >= 0 ? state[2 * p] : 0.0;
+          c += geo.N[q][a] * ca;
+          gx += geo.dNdx[q][a][0] * ca;
+          gy += geo.dNdx[q][a][1] * ca;
+        }
+        local[0] += geo.w[q] * well(m, c);
+        local[1] += geo.w[q] * 0.5 * m.kappa * (gx * gx + gy * gy);
+        sum_sq += c * c;
+        sum_4 += c * c * c * c;
+        if (geo.buffer) local[3] += geo.w[q] * m.lambda_b * c * c;
+      }
+      // lambda sum_{k<l} c_k^2 c_l^2 = lambda/2 ((sum c^2)^2 - sum c^4)
+      local[2] += geo.w[q] * 0.5 * m.lambda * (sum_sq * sum_sq - sum_4);
+    }
+  }
+  double global[4];
+  comm_.SumAll(local, global, 4);
+  return sp_energy_parts{global[0], global[1], global[2], global[3]};
+}
+
+double Assembly::check_jacobian(const sp_step_data &d, const double *state, int kind) const {
+  Gathered g;
+  std::vector<double> R, K, Rfd, Kfd;
+  double worst = 0.0;
+  for (int e : my_elems_) {
+    gather(e, d, state, g);
+    const int n = 8 * g.n_cells;
+    R.assign(n, 0.0); Rfd.assign(n, 0.0);
+    K.assign((size_t)n * n, 0.0); Kfd.assign((size_t)n * n, 0.0);
+    element_matrix(e, d, g, kind, R.data(), K.data());
+    element_matrix(e, d, g, SP_SOLVER_JAC_FD, Rfd.data(), Kfd.data());
+    double scale = 0.0, diff = 0.0;
+    for (int i = 0; i < n; ++i) {
+      if (g.dof[i] < 0) continue;
+      for (int j = 0; j < n; ++j) {
+        if (g.dof[j] < 0) continue;
+        scale = std::max(scale, std::fabs(Kfd[(size_t)i * n + j]));
+        diff = std::max(diff, std::fabs(K[(size_t)i * n + j] - Kfd[(size_t)i * n + j]));
+      }
+    }
+    if (scale > 0) worst = std::max(worst, diff / scale);
+  }
+  double global;
+  comm_.MaxAll(&worst, &global, 1);
+  return global;
+}
+
+}  // namespace sp

@@ -1,0 +1,73 @@
+// Assembly of the step equations over the mesh, driven by the layout:
+// element -> (cells present, pairs of their nodes), Epetra maps from the node
+// partition, the matrix graph, residual/Jacobian fills and energies.
+#ifndef SP_ASSEMBLY_HPP
+#define SP_ASSEMBLY_HPP
+
+#include <Epetra_Comm.h>
+#include <Epetra_CrsGraph.h>
+#include <Epetra_FECrsMatrix.h>
+#include <Epetra_Map.h>
+#include <Epetra_Vector.h>
+
+#include <memory>
+#include <vector>
+
+#include "residual.hpp"
+#include "softpack_solver.h"
+
+namespace sp {
+
+class Assembly {
+ public:
+  Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
+           const sp_layout_view &layout);
+
+  // True if the layout is the one this assembly was built for.
+  bool same_layout(const sp_layout_view &layout) const;
+
+  const Epetra_Map &map() const { return *map_; }
+  const Epetra_CrsGraph &graph() const { return *graph_; }
+  int n_dofs() const { return 2 * n_pairs_; }
+
+  // Residual F (owned rows of map()) at the full (replicated) state.
+  void residual(const sp_step_data &data, const double *state, Epetra_Vector &F) const;
+  // Jacobian of kind SP_SOLVER_JAC_* into J (values replaced).
+  void jacobian(const sp_step_data &data, const double *state, int kind,
+                Epetra_FECrsMatrix &J) const;
+  // Energy parts summed over this rank's elements and reduced.
+  sp_energy_parts energy(const sp_model_params &model, const double *state) const;
+  // Largest |J_kind - J_fd| / max|J_fd| over elements (reduced).
+  double check_jacobian(const sp_step_data &data, const double *state, int kind) const;
+
+ private:
+  struct Gathered;  // per-element scratch
+  int sp_layout_pair_of(int cell, int node) const;
+  int n_cells_on(int e) const { return elem_start_[e + 1] - elem_start_[e]; }
+  void gather(int e, const sp_step_data &data, const double *state,
+              Gathered &g) const;
+  void element_matrix(int e, const sp_step_data &data, const Gathered &g,
+                      int kind, double *R, double *K) const;
+
+  const Epetra_Comm &comm_;
+  int n_nodes_, n_pairs_, n_cells_;
+  std::vector<int> node_start_, pair_cell_;
+  std::vector<ElementGeometry> geometry_;
+  std::vector<int> my_elems_;    // elements this rank assembles
+  std::vector<int> elem_start_;  // slots of element e: elem_start_[e]..[e+1]
+  std::vector<int> slot_cell_;   // cell of each slot
+  std::vector<int> slot_pair_;   // 4 per slot: pair of (cell, node a) or -1
+  std::unique_ptr<Epetra_Map> map_;
+  std::unique_ptr<Epetra_CrsGraph> graph_;
+};
+
+// Whether the entry (row of slot j field f, column of slot j2 field f2)
+// can be non-zero: c-rows see only their own cell; mu-rows see their own
+// cell and the c of every other cell present (the repulsion).
+inline bool coupled(int j, int f, int j2, int f2) {
+  if (j == j2) return true;
+  return f == 1 && f2 == 0;
+}
+
+}  // namespace sp
+#endif

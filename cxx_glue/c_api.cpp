@@ -1,0 +1,107 @@
+// The extern "C" door: argument checks, try/catch, codes. No exception
+// crosses it (NOX also throws const char*, hence catch (...)).
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "newton.hpp"
+#include "softpack_solver.h"
+
+struct sp_solver_s {
+  std::unique_ptr<sp::Solver> impl;
+  std::string error;
+};
+
+namespace {
+
+const int SP_API_ERR = 1;  // a hard error (not a Newton failure)
+
+template <class F> int guarded(sp_solver s, F &&body) {
+  try {
+    body();
+    return 0;
+  } catch (const std::exception &e) {
+    if (s) s->error = e.what();
+  } catch (const char *e) {
+    if (s) s->error = std::string("NOX: ") + e;
+  } catch (...) {
+    if (s) s->error = "unknown exception in the Trilinos glue";
+  }
+  return SP_API_ERR + 1;
+}
+
+void need(bool ok, const char *what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+
+}  // namespace
+
+extern "C" {
+
+int sp_solver_create(MPI_Comm comm, const sp_solver_options *options, sp_solver *out) {
+  if (!options || !out) return SP_API_ERR + 1;
+  sp_solver s = new (std::nothrow) sp_solver_s;
+  if (!s) return SP_API_ERR + 1;
+  *out = s;
+  return guarded(s, [&] { s->impl.reset(new sp::Solver(comm, *options)); });
+}
+
+int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh, const sp_layout_view *layout) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl != nullptr, "the solver was not created");
+    need(mesh && layout, "sp_solver_set_problem: mesh and layout are required");
+    s->impl->set_problem(*mesh, *layout);
+  });
+}
+
+int sp_solver_step(sp_solver s, const sp_step_data *data, double *state, sp_step_report *report) {
+  if (!s) return SP_API_ERR + 1;
+  int newton = 0;
+  int rc = guarded(s, [&] {
+    need(s->impl != nullptr, "the solver was not created");
+    need(data && state && report && data->state_old, "sp_solver_step: null argument");
+    need(data->dt > 0, "sp_solver_step: dt must be positive");
+    newton = s->impl->step(*data, state, *report);
+  });
+  if (rc != 0) return rc;
+  if (newton != 0) s->error = report->reason;
+  return newton;
+}
+
+int sp_solver_energy(sp_solver s, const sp_model_params *model, const double *state,
+                     sp_energy_parts *parts) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl && model && state && parts, "sp_solver_energy: null argument");
+    *parts = s->impl->energy(*model, state);
+  });
+}
+
+int sp_solver_residual(sp_solver s, const sp_step_data *data, const double *state,
+                       double *residual) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl && data && state && residual, "sp_solver_residual: null argument");
+    s->impl->residual(*data, state, residual);
+  });
+}
+
+int sp_solver_check_jacobian(sp_solver s, const sp_step_data *data, const double *state,
+                             int jacobian, double *max_rel_err) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl && data && state && max_rel_err, "sp_solver_check_jacobian: null argument");
+    *max_rel_err = s->impl->check_jacobian(*data, state, jacobian);
+  });
+}
+
+const char *sp_solver_last_error(sp_solver s) { return s ? s->error.c_str() : "no solver"; }
+
+void sp_solver_destroy(sp_solver *s) {
+  if (!s || !*s) return;
+  delete *s;
+  *s = nullptr;
+}
+
+}  // extern "C"

@@ -1,0 +1,109 @@
+// Serial SuperLU. The CSR arrays of A are the CSC arrays of A^T: we factor
+// A^T = Pr^T L U Pc^T and solve A x = b with the transposed triangular
+// solves, exactly what dgssvx does for SLU_NR input, but with the
+// factorisation and the solves split (they are timed separately) and the
+// column ordering kept while the pattern is unchanged.
+// slu_ddefs.h clashes with SuperLU_DIST's headers: keep it alone in this TU.
+#include <slu_ddefs.h>
+
+#include <cstring>
+#include <vector>
+
+#include "linear.hpp"
+
+namespace sp {
+namespace {
+
+class SuperLU final : public DirectSolver {
+ public:
+  SuperLU() {
+    set_default_options(&options_);
+    options_.ColPerm = COLAMD;
+    StatInit(&stat_);
+  }
+  ~SuperLU() override {
+    release_factors();
+    StatFree(&stat_);
+  }
+
+  bool factor(int n, const int *row_ptr, const int *col, const double *val,
+              bool same_pattern, std::string &why) override {
+    release_factors();
+    const int nnz = row_ptr[n];
+    // SuperLU keeps pointers into A: own copies of the arrays.
+    ptr_.assign(row_ptr, row_ptr + n + 1);
+    idx_.assign(col, col + nnz);
+    val_.assign(val, val + nnz);
+    SuperMatrix At;  // CSC of A^T = CSR of A
+    dCreate_CompCol_Matrix(&At, n, n, nnz, val_.data(), idx_.data(), ptr_.data(),
+                           SLU_NC, SLU_D, SLU_GE);
+    if (!same_pattern || (int)perm_c_.size() != n) {
+      perm_c_.assign(n, 0);
+      get_perm_c(options_.ColPerm, &At, perm_c_.data());
+      ++symbolic_;
+    }
+    perm_r_.assign(n, 0);
+    etree_.assign(n, 0);
+    SuperMatrix AC;
+    options_.Fact = DOFACT;
+    sp_preorder(&options_, &At, perm_c_.data(), etree_.data(), &AC);
+    int info = 0;
+    GlobalLU_t glu;
+    dgstrf(&options_, &AC, sp_ienv(2), sp_ienv(1), etree_.data(), nullptr, 0,
+           perm_c_.data(), perm_r_.data(), &L_, &U_, &glu, &stat_, &info);
+    Destroy_CompCol_Permuted(&AC);
+    Destroy_SuperMatrix_Store(&At);
+    have_factors_ = info <= n;  // info > n: allocation failure, no L/U
+    if (info != 0) {
+      why = info <= n ? "SuperLU: the matrix is singular (zero pivot in column " +
+                            std::to_string(info) + ")"
+                      : "SuperLU: out of memory in the factorisation";
+      release_factors();
+      return false;
+    }
+    n_ = n;
+    return true;
+  }
+
+  bool solve(const double *b, double *x, std::string &why) override {
+    if (!have_factors_) {
+      why = "SuperLU: solve without a factorisation";
+      return false;
+    }
+    std::memcpy(x, b, sizeof(double) * n_);
+    SuperMatrix B;
+    dCreate_Dense_Matrix(&B, n_, 1, x, n_, SLU_DN, SLU_D, SLU_GE);
+    int info = 0;
+    dgstrs(TRANS, &L_, &U_, perm_c_.data(), perm_r_.data(), &B, &stat_, &info);
+    Destroy_SuperMatrix_Store(&B);
+    if (info != 0) {
+      why = "SuperLU: triangular solve failed (info " + std::to_string(info) + ")";
+      return false;
+    }
+    return true;
+  }
+
+  int symbolic_count() const override { return symbolic_; }
+
+ private:
+  void release_factors() {
+    if (!have_factors_) return;
+    Destroy_SuperNode_Matrix(&L_);
+    Destroy_CompCol_Matrix(&U_);
+    have_factors_ = false;
+  }
+
+  superlu_options_t options_;
+  SuperLUStat_t stat_;
+  SuperMatrix L_, U_;
+  bool have_factors_ = false;
+  int n_ = 0, symbolic_ = 0;
+  std::vector<int> ptr_, idx_, perm_c_, perm_r_, etree_;
+  std::vector<double> val_;
+};
+
+}  // namespace
+
+std::unique_ptr<DirectSolver> make_superlu() { return std::make_unique<SuperLU>(); }
+
+}  // namespace sp

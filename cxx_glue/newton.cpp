@@ -1,0 +1,312 @@
+#include "newton.hpp"
+
+#include <Epetra_Import.h>
+#include <NOX.H>
+#include <NOX_Epetra_Group.H>
+#include <NOX_Epetra_Interface_Jacobian.H>
+#include <NOX_Epetra_Interface_Required.H>
+#include <NOX_Epetra_LinearSystem.H>
+#include <NOX_Epetra_Vector.H>
+#include <NOX_Observer.hpp>
+#include <NOX_StatusTest_Combo.H>
+#include <NOX_StatusTest_Divergence.H>
+#include <NOX_StatusTest_FiniteValue.H>
+#include <NOX_StatusTest_MaxIters.H>
+#include <NOX_StatusTest_NormF.H>
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace sp {
+namespace {
+
+double now() {
+  using namespace std::chrono;
+  return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+// NOX's callbacks: residual and Jacobian of one step.
+class StepInterface : public NOX::Epetra::Interface::Required,
+                      public NOX::Epetra::Interface::Jacobian {
+ public:
+  StepInterface(Solver &s, const sp_step_data &d) : s_(s), d_(d) {}
+  bool computeF(const Epetra_Vector &x, Epetra_Vector &F, FillType) override {
+    s_.fill_residual(d_, x, F);
+    return true;
+  }
+  bool computeJacobian(const Epetra_Vector &x, Epetra_Operator &) override {
+    s_.fill_jacobian(d_, x);
+    return true;
+  }
+
+ private:
+  Solver &s_;
+  const sp_step_data &d_;
+};
+
+// NOX's hook for a direct solver: J is assembled by StepInterface and
+// factored here; there is no preconditioner.
+class DirectLinearSystem : public NOX::Epetra::LinearSystem {
+ public:
+  DirectLinearSystem(Solver &s, StepInterface &i) : s_(s), i_(i) {}
+  bool applyJacobian(const NOX::Epetra::Vector &in, NOX::Epetra::Vector &out) const override {
+    return s_.jacobian_matrix->Apply(in.getEpetraVector(), out.getEpetraVector()) == 0;
+  }
+  bool applyJacobianTranspose(const NOX::Epetra::Vector &in,
+                              NOX::Epetra::Vector &out) const override {
+    s_.jacobian_matrix->SetUseTranspose(true);
+    bool ok = s_.jacobian_matrix->Apply(in.getEpetraVector(), out.getEpetraVector()) == 0;
+    s_.jacobian_matrix->SetUseTranspose(false);
+    return ok;
+  }
+  bool applyJacobianInverse(Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
+                            NOX::Epetra::Vector &out) override {
+    std::string why;
+    bool ok = s_.solve_linear(in.getEpetraVector(), out.getEpetraVector(), why);
+    if (!ok) s_.last_error = why;
+    return ok;
+  }
+  bool applyRightPreconditioning(bool, Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
+                                 NOX::Epetra::Vector &out) const override {
+    out = in;
+    return true;
+  }
+  Teuchos::RCP<NOX::Epetra::Scaling> getScaling() override { return Teuchos::null; }
+  void resetScaling(const Teuchos::RCP<NOX::Epetra::Scaling> &) override {}
+  bool computeJacobian(const NOX::Epetra::Vector &x) override {
+    return i_.computeJacobian(x.getEpetraVector(), *s_.jacobian_matrix);
+  }
+  bool createPreconditioner(const NOX::Epetra::Vector &, Teuchos::ParameterList &,
+                            bool) const override { return false; }
+  bool destroyPreconditioner() const override { return false; }
+  bool recomputePreconditioner(const NOX::Epetra::Vector &,
+                               Teuchos::ParameterList &) const override { return false; }
+  PreconditionerReusePolicyType getPreconditionerPolicy(bool) override { return PRPT_REBUILD; }
+  bool isPreconditionerConstructed() const override { return false; }
+  bool hasPreconditioner() const override { return false; }
+  Teuchos::RCP<const Epetra_Operator> getJacobianOperator() const override {
+    return s_.jacobian_matrix;
+  }
+  Teuchos::RCP<Epetra_Operator> getJacobianOperator() override { return s_.jacobian_matrix; }
+  Teuchos::RCP<const Epetra_Operator> getGeneratedPrecOperator() const override {
+    return Teuchos::null;
+  }
+  Teuchos::RCP<Epetra_Operator> getGeneratedPrecOperator() override { return Teuchos::null; }
+  // NOX hands back the same matrix before every solve: nothing to drop.
+  void setJacobianOperatorForSolve(const Teuchos::RCP<const Epetra_Operator> &) override {}
+  void setPrecOperatorForSolve(const Teuchos::RCP<const Epetra_Operator> &) override {}
+
+ private:
+  Solver &s_;
+  StepInterface &i_;
+};
+
+// Records ||F|| at the start and after every iteration.
+class ResidualRecorder : public NOX::Observer {
+ public:
+  explicit ResidualRecorder(sp_step_report &r) : r_(r) {}
+  void runPreSolve(const NOX::Solver::Generic &solver) override { record(solver); }
+  void runPostIterate(const NOX::Solver::Generic &solver) override { record(solver); }
+
+ private:
+  void record(const NOX::Solver::Generic &solver) {
+    if (r_.n_residuals < SP_MAX_NEWTON_HISTORY)
+      r_.residual_norms[r_.n_residuals++] = solver.getSolutionGroup().getNormF();
+  }
+  sp_step_report &r_;
+};
+
+// Converged only after at least one Newton update: the update conserves
+// each cell's mass to round-off, a residual tolerance alone would not.
+class AtLeastOneIteration : public NOX::StatusTest::Generic {
+ public:
+  NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic &solver,
+                                          NOX::StatusTest::CheckType) override {
+    status_ = solver.getNumIterations() >= 1 ? NOX::StatusTest::Converged
+                                             : NOX::StatusTest::Unconverged;
+    return status_;
+  }
+  NOX::StatusTest::StatusType getStatus() const override { return status_; }
+  std::ostream &print(std::ostream &s, int indent) const override {
+    for (int i = 0; i < indent; ++i) s << ' ';
+    s << status_ << "At least one Newton update\n";
+    return s;
+  }
+
+ private:
+  NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unevaluated;
+};
+
+}  // namespace
+
+Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
+    : comm_(comm), options_(options) {
+  if (options.linear != SP_SOLVER_SUPERLU)
+    throw std::runtime_error("solver.linear: only superlu is built so far");
+  if (comm_.NumProc() > 1)
+    throw std::runtime_error("solver.linear superlu runs on one process; MPI runs are not built yet");
+  if (options.jacobian < SP_SOLVER_JAC_AD || options.jacobian > SP_SOLVER_JAC_FD)
+    throw std::runtime_error("solver.jacobian: unknown kind");
+  direct_ = make_superlu();
+}
+
+void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout) {
+  if (assembly_ && assembly_->same_layout(layout)) return;
+  assembly_.reset(new Assembly(comm_, mesh, layout));
+  jacobian_matrix = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
+  // The CSR pattern handed to the direct solver (one rank: local = global).
+  const Epetra_CrsGraph &g = assembly_->graph();
+  const int n = g.NumMyRows();
+  csr_ptr_.assign(1, 0);
+  csr_col_.clear();
+  for (int i = 0; i < n; ++i) {
+    int len, *idx;
+    g.ExtractMyRowView(i, len, idx);
+    for (int k = 0; k < len; ++k) csr_col_.push_back(g.RowMap().LID(g.ColMap().GID(idx[k])));
+    csr_ptr_.push_back((int)csr_col_.size());
+  }
+  csr_val_.assign(csr_col_.size(), 0.0);
+  pattern_changed_ = true;
+  jacobian_fresh_ = false;
+}
+
+void Solver::require_problem() const {
+  if (!assembly_) throw std::runtime_error("sp_solver_set_problem was not called");
+}
+
+void Solver::gather(const Epetra_Vector &x, std::vector<double> &full) const {
+  // Each rank owns a contiguous DOF range in rank order: an allgather.
+  const int P = comm_.NumProc();
+  std::vector<int> counts(P), displs(P, 0);
+  int mine = x.MyLength();
+  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_.Comm());
+  for (int r = 1; r < P; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  full.resize(assembly_->n_dofs());
+  MPI_Allgatherv(x.Values(), mine, MPI_DOUBLE, full.data(), counts.data(), displs.data(),
+                 MPI_DOUBLE, comm_.Comm());
+}
+
+void Solver::fill_residual(const sp_step_data &d, const Epetra_Vector &x, Epetra_Vector &F) {
+  double t0 = now();
+  gather(x, full_);
+  assembly_->residual(d, full_.data(), F);
+  t_assembly += now() - t0;
+}
+
+void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
+  double t0 = now();
+  gather(x, full_);
+  assembly_->jacobian(d, full_.data(), options_.jacobian, *jacobian_matrix);
+  jacobian_fresh_ = true;
+  t_assembly += now() - t0;
+}
+
+bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
+  if (jacobian_fresh_) {
+    double t0 = now();
+    const int n = (int)csr_ptr_.size() - 1;
+    for (int i = 0, pos = 0; i < n; ++i) {
+      int len;
+      double *vals;
+      jacobian_matrix->ExtractMyRowView(i, len, vals);
+      for (int k = 0; k < len; ++k) csr_val_[pos++] = vals[k];
+    }
+    bool ok = direct_->factor(n, csr_ptr_.data(), csr_col_.data(), csr_val_.data(),
+                              !pattern_changed_, why);
+    t_factor += now() - t0;
+    if (!ok) return false;
+    pattern_changed_ = false;
+    jacobian_fresh_ = false;
+  }
+  double t0 = now();
+  bool ok = direct_->solve(b.Values(), x.Values(), why);
+  t_solve += now() - t0;
+  return ok;
+}
+
+int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
+  require_problem();
+  report = sp_step_report{};
+  t_assembly = t_factor = t_solve = 0;
+  const double t_start = now();
+  const Epetra_Map &map = assembly_->map();
+  Epetra_Vector x0(map);
+  for (int i = 0; i < map.NumMyElements(); ++i) x0[i] = state[map.GID(i)];
+
+  auto iface = Teuchos::rcp(new StepInterface(*this, d));
+  auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *iface));
+  auto params = Teuchos::rcp(new Teuchos::ParameterList);
+  params->set("Nonlinear Solver", "Line Search Based");
+  params->sublist("Line Search").set("Method", "Full Step");
+  params->sublist("Direction").set("Method", "Newton");
+  params->sublist("Direction").sublist("Newton").set("Rescue Bad Newton Solve", false);
+  params->sublist("Printing").set("Output Information", 0);
+  params->sublist("Solver Options").set("Status Test Check Type", "Complete");
+  params->sublist("Solver Options").set<Teuchos::RCP<NOX::Observer>>(
+      "User Defined Pre/Post Operator", Teuchos::rcp(new ResidualRecorder(report)));
+  NOX::Epetra::Vector guess(x0, NOX::DeepCopy);
+  auto group = Teuchos::rcp(new NOX::Epetra::Group(params->sublist("Printing"), iface, guess, linsys));
+
+  using namespace NOX::StatusTest;
+  auto converged = Teuchos::rcp(new Combo(Combo::AND));
+  auto tolerance = Teuchos::rcp(new Combo(Combo::OR));
+  tolerance->addStatusTest(Teuchos::rcp(new NormF(options_.newton_atol, NormF::Unscaled)));
+  tolerance->addStatusTest(Teuchos::rcp(new NormF(*group, options_.newton_rtol, NormF::Unscaled)));
+  converged->addStatusTest(tolerance);
+  converged->addStatusTest(Teuchos::rcp(new AtLeastOneIteration));
+  auto all = Teuchos::rcp(new Combo(Combo::OR));
+  all->addStatusTest(Teuchos::rcp(new FiniteValue));
+  all->addStatusTest(converged);
+  all->addStatusTest(Teuchos::rcp(new MaxIters(options_.newton_max_its)));
+  all->addStatusTest(Teuchos::rcp(new Divergence(1e30)));
+  // The relative test evaluated F at the guess: that fill is not a Newton
+  // iteration's work but is counted in assembly all the same.
+
+  auto solver = NOX::Solver::buildSolver(group, all, params);
+  last_error.clear();
+  StatusType status = solver->solve();
+  report.newton_its = solver->getNumIterations();
+  report.t_assembly = t_assembly;
+  report.t_factor = t_factor;
+  report.t_solve = t_solve;
+  if (status == Converged) {
+    const auto &xs = dynamic_cast<const NOX::Epetra::Vector &>(
+        solver->getSolutionGroup().getX()).getEpetraVector();
+    gather(xs, full_);
+    std::copy(full_.begin(), full_.end(), state);
+    report.converged = 1;
+    report.t_total = now() - t_start;
+    return 0;
+  }
+  const double last = report.n_residuals ? report.residual_norms[report.n_residuals - 1] : NAN;
+  std::string why = !last_error.empty() ? last_error
+                    : !std::isfinite(last) ? "the residual is not finite"
+                    : report.newton_its >= options_.newton_max_its
+                        ? "no convergence in " + std::to_string(options_.newton_max_its) + " Newton iterations"
+                        : "Newton failed";
+  snprintf(report.reason, sizeof report.reason, "%s (last |F| = %.3g)", why.c_str(), last);
+  report.t_total = now() - t_start;
+  return 1;  // state untouched: x0 was a copy
+}
+
+sp_energy_parts Solver::energy(const sp_model_params &m, const double *state) const {
+  require_problem();
+  return assembly_->energy(m, state);
+}
+
+void Solver::residual(const sp_step_data &d, const double *state, double *out) const {
+  require_problem();
+  Epetra_Vector F(assembly_->map());
+  assembly_->residual(d, state, F);
+  std::vector<double> full;
+  gather(F, full);
+  std::copy(full.begin(), full.end(), out);
+}
+
+double Solver::check_jacobian(const sp_step_data &d, const double *state, int kind) const {
+  require_problem();
+  return assembly_->check_jacobian(d, state, kind);
+}
+
+}  // namespace sp

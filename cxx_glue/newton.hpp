@@ -1,0 +1,58 @@
+// The object behind the sp_solver handle: an Assembly for the current
+// layout, the Jacobian matrix, a direct solver, and one NOX Newton solve per
+// backward-Euler step.
+#ifndef SP_NEWTON_HPP
+#define SP_NEWTON_HPP
+
+#include <Epetra_FECrsMatrix.h>
+#include <Epetra_MpiComm.h>
+#include <Teuchos_RCP.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "assembly.hpp"
+#include "linear.hpp"
+#include "softpack_solver.h"
+
+namespace sp {
+
+class Solver {
+ public:
+  Solver(MPI_Comm comm, const sp_solver_options &options);
+
+  void set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout);
+  // Returns 0 when converged, 1 when Newton failed (state restored).
+  int step(const sp_step_data &data, double *state, sp_step_report &report);
+  sp_energy_parts energy(const sp_model_params &m, const double *state) const;
+  void residual(const sp_step_data &data, const double *state, double *residual) const;
+  double check_jacobian(const sp_step_data &data, const double *state, int kind) const;
+
+  // Called by the NOX interface and linear system (newton.cpp).
+  void fill_residual(const sp_step_data &data, const Epetra_Vector &x, Epetra_Vector &F);
+  void fill_jacobian(const sp_step_data &data, const Epetra_Vector &x);
+  bool solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why);
+
+  std::string last_error;
+  Teuchos::RCP<Epetra_FECrsMatrix> jacobian_matrix;
+  double t_assembly = 0, t_factor = 0, t_solve = 0;
+
+ private:
+  void require_problem() const;
+  // The full (replicated) state from a distributed vector.
+  void gather(const Epetra_Vector &x, std::vector<double> &full) const;
+
+  Epetra_MpiComm comm_;
+  sp_solver_options options_;
+  std::unique_ptr<Assembly> assembly_;
+  std::unique_ptr<DirectSolver> direct_;
+  std::vector<int> csr_ptr_, csr_col_;  // pattern of the matrix, row-wise
+  std::vector<double> csr_val_;
+  bool jacobian_fresh_ = false;  // the matrix changed since the last factor
+  bool pattern_changed_ = true;  // the layout changed since the last factor
+  std::vector<double> full_;     // scratch: the replicated state
+};
+
+}  // namespace sp
+#endif

@@ -1,0 +1,48 @@
+// The pointwise physics of MODEL.md, written once and templated on the
+// scalar type: double for residuals and energies, Sacado Fad types for the
+// AD Jacobian. The hand Jacobian uses the explicit derivatives below.
+#ifndef SP_PHYSICS_HPP
+#define SP_PHYSICS_HPP
+
+#include "softpack_solver.h"
+
+namespace sp {
+
+// Bulk double well f(c) = alpha c^2 (c-1)^2 and its derivatives.
+template <class S> S well(const sp_model_params &m, const S &c) {
+  return m.alpha * c * c * (c - 1.0) * (c - 1.0);
+}
+template <class S> S well_d1(const sp_model_params &m, const S &c) {
+  return 2.0 * m.alpha * c * (c - 1.0) * (2.0 * c - 1.0);
+}
+inline double well_d2(const sp_model_params &m, double c) {
+  return 2.0 * m.alpha * (6.0 * c * c - 6.0 * c + 1.0);
+}
+
+// Pair repulsion: energy lambda sum_{k<l} c_k^2 c_l^2 (unordered pairs), so
+// its derivative in c_k is 2 lambda c_k sum_{l!=k} c_l^2 = 2 lambda c_k
+// (sum_sq - c_k^2), with sum_sq = sum_l c_l^2.
+template <class S>
+S repulsion_d1(const sp_model_params &m, const S &c, const S &sum_sq) {
+  return 2.0 * m.lambda * c * (sum_sq - c * c);
+}
+
+// Buffer ring penalty lambda_b c^2 per field, derivative 2 lambda_b c.
+template <class S> S buffer_d1(const sp_model_params &m, const S &c) {
+  return 2.0 * m.lambda_b * c;
+}
+
+// The explicit shape term's value in mu_k at X: -sum_i coef_i v_i.Ibar(X) v_i
+// with Ibar(X) = [[Xb2^2, -Xb1 Xb2], [-Xb1 Xb2, Xb1^2]] (MODEL.md).
+inline double shape_mu(const sp_shape_coef &s, double x, double y) {
+  double xb = x - s.xc, yb = y - s.yc, value = 0.0;
+  for (int i = 0; i < 2; ++i) {
+    double v1 = s.v[i][0], v2 = s.v[i][1];
+    double ihat = v1 * v1 * yb * yb - 2.0 * v1 * v2 * xb * yb + v2 * v2 * xb * xb;
+    value -= s.coef[i] * ihat;
+  }
+  return value;
+}
+
+}  // namespace sp
+#endif

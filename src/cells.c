@@ -1,0 +1,116 @@
+#include "cells.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "error.h"
+#include "q1.h"
+
+void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
+                        double *I2, double v1[2], double v2[2]) {
+  const double mean = 0.5 * (Ixx + Iyy);
+  const double radius = hypot(0.5 * (Ixx - Iyy), Ixy);
+  *I1 = mean + radius;
+  *I2 = mean - radius;
+  /* Eigenvector of the larger eigenvalue at angle theta with
+   * tan(2 theta) = 2 Ixy / (Ixx - Iyy); any direction when round. */
+  const double theta = 0.5 * atan2(2.0 * Ixy, Ixx - Iyy);
+  v1[0] = cos(theta);
+  v1[1] = sin(theta);
+  v2[0] = -v1[1];
+  v2[1] = v1[0];
+}
+
+int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
+                     const double *state, double weight_threshold,
+                     sp_cell_obs *obs) {
+  const int nc = layout->n_cells;
+  /* Per cell: mass, weighted mass, first and second moments. */
+  double *sums;
+  SP_ALLOC(sums, 7 * (size_t)nc);
+  for (int e = 0; e < mesh->n_elems; ++e) {
+    double xy[4][2];
+    sp_mesh_elem_xy(mesh, e, xy);
+    const int *nodes = mesh->elem + 4 * e;
+    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+      double N[4], dNdx[4][2], x[2], w;
+      sp_q1_point(xy, q, N, dNdx, x, &w);
+      /* Cells present at the element's nodes. */
+      for (int a = 0; a < 4; ++a)
+        for (int p = layout->node_start[nodes[a]]; p < layout->node_start[nodes[a] + 1]; ++p) {
+          const int k = layout->pair_cell[p];
+          /* Each cell once per point: only from its first node here. */
+          int first = 1;
+          for (int b = 0; b < a; ++b)
+            if (sp_layout_pair(layout, k, nodes[b]) >= 0) first = 0;
+          if (!first) continue;
+          double c = 0;
+          for (int b = 0; b < 4; ++b) {
+            int pb = sp_layout_pair(layout, k, nodes[b]);
+            if (pb >= 0) c += N[b] * state[2 * pb];
+          }
+          double *s = sums + 7 * k;
+          s[0] += w * c;
+          const double cw = c >= weight_threshold ? c : 0.0;
+          s[1] += w * cw;
+          s[2] += w * cw * x[0];
+          s[3] += w * cw * x[1];
+          s[4] += w * cw * x[0] * x[0];
+          s[5] += w * cw * x[1] * x[1];
+          s[6] += w * cw * x[0] * x[1];
+        }
+    }
+  }
+  for (int k = 0; k < nc; ++k) {
+    const double *s = sums + 7 * k;
+    sp_cell_obs *o = obs + k;
+    o->mass = s[0];
+    const double m = s[1] > 0 ? s[1] : 1.0;
+    o->xc = s[2] / m;
+    o->yc = s[3] / m;
+    /* Central moments: int c Xb1^2 = int c x^2 - m xc^2, etc. */
+    const double xx = s[4] - m * o->xc * o->xc;
+    const double yy = s[5] - m * o->yc * o->yc;
+    const double xy = s[6] - m * o->xc * o->yc;
+    o->Ixx = yy;
+    o->Iyy = xx;
+    o->Ixy = -xy;
+    sp_cells_principal(o->Ixx, o->Iyy, o->Ixy, &o->I1, &o->I2, o->v1, o->v2);
+    o->angle = atan2(o->v1[1], o->v1[0]);
+    if (o->angle <= -M_PI / 2) o->angle += M_PI;
+    if (o->angle > M_PI / 2) o->angle -= M_PI;
+  }
+  free(sums);
+  return SP_OK;
+}
+
+double sp_random_symmetric(unsigned long long *rng) {
+  unsigned long long z = (*rng += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  z ^= z >> 31;
+  return 2.0 * (double)(z >> 11) / 9007199254740992.0 - 1.0;
+}
+
+int sp_cells_initial_state(const sp_scene *scene, const sp_mesh *mesh,
+                           const sp_layout *layout, double *state) {
+  const double d = sp_scene_interface_width(scene);
+  const sp_scene_noise *noise = &scene->noise;
+  for (int k = 0; k < layout->n_cells; ++k) {
+    const sp_scene_cell *cell = &scene->cells[k];
+    /* One stream per cell, so adding a cell does not change the others. */
+    unsigned long long rng = (unsigned long long)noise->seed * 1000003ULL + (unsigned long long)k;
+    for (int i = 0; i < mesh->n_nodes; ++i) {
+      const double xi = noise->amplitude > 0 ? sp_random_symmetric(&rng) : 0.0;
+      const int p = sp_layout_pair(layout, k, i);
+      if (p < 0) continue;
+      const double r = hypot(mesh->xy[2 * i] - cell->x, mesh->xy[2 * i + 1] - cell->y);
+      const double profile = cell->profile == SP_PROFILE_SHARP
+                                 ? (r <= cell->radius ? 1.0 : 0.0)
+                                 : 1.0 / (1.0 + exp((r - cell->radius) / d));
+      state[2 * p] = profile + (1.0 - profile) * (noise->background + noise->amplitude * xi);
+      state[2 * p + 1] = 0.0;
+    }
+  }
+  return SP_OK;
+}

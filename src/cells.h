@@ -1,0 +1,61 @@
+/**
+ * @file cells.h
+ * @brief The cell registry and the geometric observables of each cell
+ *        computed from its field c_k alone (mesh integrals, 2x2 Gauss).
+ */
+#ifndef SP_CELLS_H
+#define SP_CELLS_H
+
+#include "layout.h"
+#include "mesh.h"
+#include "scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Observables of one cell (MODEL.md, shape penalty, for the tensor). */
+typedef struct {
+  double mass;      /**< m_k = int c_k dV (the conserved quantity) */
+  double xc, yc;    /**< centre of mass int c X / int c */
+  double Ixx, Iyy, Ixy; /**< inertia tensor [[Ixx, Ixy],[Ixy, Iyy]] about
+                             the centre: Ixx = int c Xb2^2, Iyy = int c Xb1^2,
+                             Ixy = -int c Xb1 Xb2 */
+  double I1, I2;    /**< principal moments, I1 >= I2 */
+  double v1[2], v2[2]; /**< unit eigenvectors of I1 and I2 */
+  double angle;     /**< angle of v1 from the x axis, in (-pi/2, pi/2] */
+} sp_cell_obs;
+
+/**
+ * @brief Observables of every cell of a state.
+ * @param[in] weight_threshold centre and inertia integrate c only where
+ *            c >= this (0: everywhere), so a background does not count;
+ *            the mass is always the full integral
+ * @param[out] obs n_cells entries
+ */
+int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
+                     const double *state, double weight_threshold,
+                     sp_cell_obs *obs);
+
+/** @brief Principal moments and unit eigenvectors of a symmetric 2x2
+ *         tensor, larger first (v1 is the larger moment's). */
+void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
+                        double *I2, double v1[2], double v2[2]);
+
+/**
+ * @brief The initial fields of a scene (MODEL.md): cell k's profile p_k
+ *        (tanh with the equilibrium width d, or sharp) plus the seeded
+ *        background, c_k = p_k + (1 - p_k) (b + a U(-1,1)), and mu_k = 0.
+ * @param[out] state 2 n_pairs values in layout order
+ */
+int sp_cells_initial_state(const sp_scene *scene, const sp_mesh *mesh,
+                           const sp_layout *layout, double *state);
+
+/** @brief Uniform random number in [-1, 1) from a 64-bit state (splitmix64):
+ *         the same sequence on every machine for a given seed. */
+double sp_random_symmetric(unsigned long long *rng);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

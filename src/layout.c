@@ -1,0 +1,71 @@
+#include "layout.h"
+
+#include <stdlib.h>
+
+#include "error.h"
+
+int sp_layout_create_from_masks(int n_nodes, int n_cells,
+                                const unsigned char *in_support,
+                                sp_layout **out) {
+  SP_CHECK(n_nodes > 0 && n_cells >= 0, SP_ERR_INTERNAL,
+           "layout needs nodes (got %d) and a cell count >= 0 (got %d)",
+           n_nodes, n_cells);
+  sp_layout *l;
+  SP_ALLOC(l, 1);
+  l->n_nodes = n_nodes;
+  l->n_cells = n_cells;
+  SP_ALLOC(l->node_start, n_nodes + 1);
+  long count = 0;
+  for (int i = 0; i < n_nodes; ++i)
+    for (int k = 0; k < n_cells; ++k)
+      count += in_support[(size_t)k * n_nodes + i] != 0;
+  l->n_pairs = (int)count;
+  SP_ALLOC(l->pair_cell, count);
+  int p = 0;
+  for (int i = 0; i < n_nodes; ++i) {
+    l->node_start[i] = p;
+    for (int k = 0; k < n_cells; ++k)
+      if (in_support[(size_t)k * n_nodes + i]) l->pair_cell[p++] = k;
+  }
+  l->node_start[n_nodes] = p;
+  *out = l;
+  return SP_OK;
+}
+
+int sp_layout_create_full(int n_nodes, int n_cells, sp_layout **out) {
+  unsigned char *mask;
+  SP_ALLOC(mask, (size_t)n_nodes * (n_cells ? n_cells : 1));
+  for (size_t i = 0; i < (size_t)n_nodes * n_cells; ++i) mask[i] = 1;
+  int rc = sp_layout_create_from_masks(n_nodes, n_cells, mask, out);
+  free(mask);
+  return rc;
+}
+
+int sp_layout_pair(const sp_layout *l, int cell, int node) {
+  int lo = l->node_start[node], hi = l->node_start[node + 1] - 1;
+  while (lo <= hi) { /* pairs of a node are sorted by cell */
+    int mid = (lo + hi) / 2;
+    if (l->pair_cell[mid] == cell) return mid;
+    if (l->pair_cell[mid] < cell) lo = mid + 1;
+    else hi = mid - 1;
+  }
+  return -1;
+}
+
+void sp_layout_transfer(const sp_layout *from, const double *state_from,
+                        const sp_layout *to, double *state_to, double fill_c) {
+  for (int i = 0; i < to->n_nodes; ++i)
+    for (int p = to->node_start[i]; p < to->node_start[i + 1]; ++p) {
+      int q = i < from->n_nodes ? sp_layout_pair(from, to->pair_cell[p], i) : -1;
+      state_to[2 * p] = q >= 0 ? state_from[2 * q] : fill_c;
+      state_to[2 * p + 1] = q >= 0 ? state_from[2 * q + 1] : 0.0;
+    }
+}
+
+void sp_layout_destroy(sp_layout **layout) {
+  if (!layout || !*layout) return;
+  free((*layout)->node_start);
+  free((*layout)->pair_cell);
+  free(*layout);
+  *layout = NULL;
+}

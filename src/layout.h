@@ -1,0 +1,52 @@
+/**
+ * @file layout.h
+ * @brief Where each cell's field lives: the (cell, node) pairs that carry
+ *        unknowns. Every solver structure (DOF numbering, maps, graph) is
+ *        derived from the layout, so restricting supports changes no solver
+ *        code.
+ *
+ * Pairs are numbered node-major: the pairs of node i are
+ * node_start[i] .. node_start[i+1]-1, sorted by cell. Each pair p carries
+ * two unknowns, state[2p] = c and state[2p+1] = mu. A node partition into
+ * contiguous node ranges therefore gives contiguous DOF ranges per rank.
+ */
+#ifndef SP_LAYOUT_H
+#define SP_LAYOUT_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sp_layout {
+  int n_nodes;
+  int n_cells;
+  int n_pairs;
+  int *node_start; /**< n_nodes + 1 offsets into pair_cell */
+  int *pair_cell;  /**< cell of each pair */
+} sp_layout;
+
+/** @brief Every cell supported on every node (the paper's method). */
+int sp_layout_create_full(int n_nodes, int n_cells, sp_layout **out);
+
+/**
+ * @brief A layout from per-cell node masks: in_support[k * n_nodes + i] != 0
+ *        when node i is in cell k's support.
+ */
+int sp_layout_create_from_masks(int n_nodes, int n_cells,
+                                const unsigned char *in_support,
+                                sp_layout **out);
+
+/** @brief The pair of (cell, node), or -1 if node is outside the support. */
+int sp_layout_pair(const sp_layout *layout, int cell, int node);
+
+/** @brief Copy values from one layout's state to another's by (cell, node);
+ *         pairs absent from @p from get c = fill_c, mu = 0. */
+void sp_layout_transfer(const sp_layout *from, const double *state_from,
+                        const sp_layout *to, double *state_to, double fill_c);
+
+void sp_layout_destroy(sp_layout **layout);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,447 @@
+/**
+ * @file mesh.c
+ * @brief Rectangle meshes and the paper's five-patch disk mapped to an
+ *        ellipse (MODEL.md, "Mesh of the paper's runs" and "Buffer zone").
+ *
+ * The five-patch disk of refinement r has n = 2^r elements along every patch
+ * side: an n x n centre square and four n x n patches between the square's
+ * edges and the unit circle. Seen from outside the square the outer patches
+ * form n rings of 4n quadrilaterals each, so the disk is built as
+ *
+ *   - the centre square's (n+1)^2 grid nodes, and
+ *   - rings k = 1..n (+ buffer rings n+1..n+L) of 4n nodes each, indexed by
+ *     the angular position t = 0..4n-1 counterclockwise from the corner
+ *     (s, -s) at -45 degrees; "ring 0" is the square's own boundary.
+ *
+ * Every node therefore exists once (no merging of patch copies is needed):
+ * V = (n+1)^2 + 4n^2 (+ 4nL), E = 5n^2 (+ 4nL); r = 5 gives 5185 and 5120.
+ */
+#include "mesh.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "error.h"
+#include "q1.h"
+
+/**
+ * Half-width s of the centre square of the unit disk: s = 1/(2 + sqrt 2)
+ * ~ 0.293, the value of deal.II's GridGenerator::hyper_ball (the paper's
+ * library), chosen there to "equilibrate cell sizes at the transition": the
+ * square's side 2s equals the diagonal distance 1 - s sqrt 2 from its corner
+ * to the circle. Against the alternatives (at r = 5) it gives the least
+ * flattened elements at the circle, where the worst element sits on the
+ * diagonal with sides (pi/2)/n (along the arc) and (1 - s sqrt 2)/n (radial):
+ *   s = 0.293: max edge ratio 2.68, element areas max/min 4.2;
+ *   s = 0.396 (equal patch areas): 3.57 and 3.5;  s = 0.5: 5.36 and 4.4.
+ * tests/test_mesh.c prints the det J quality numbers.
+ */
+#define SP_MESH_SQUARE_HALF_WIDTH 0.29289321881345248 /* 1/(2 + sqrt 2) */
+
+/** pi; M_PI is not part of C11. */
+#define SP_MESH_PI 3.14159265358979323846
+
+/** Largest refinement accepted: r = 10 already has 5.2e6 nodes. */
+#define SP_MESH_MAX_REFINEMENTS 10
+
+/**
+ * Relative tolerance of sp_mesh_contains: points on the boundary computed in
+ * floating point (e.g. mesh nodes, which lie on the ellipse) count as inside.
+ */
+#define SP_MESH_CONTAINS_TOL 1e-12
+
+/* ------------------------------------------------------------------------ */
+/* Shared helpers                                                           */
+/* ------------------------------------------------------------------------ */
+
+/** Allocate the arrays of a mesh with the given counts. */
+static int mesh_allocate(int n_nodes, int n_elems, sp_mesh **out) {
+  sp_mesh *mesh;
+  SP_ALLOC(mesh, 1);
+  mesh->n_nodes = n_nodes;
+  mesh->n_elems = n_elems;
+  mesh->xy = calloc((size_t)2 * n_nodes, sizeof *mesh->xy);
+  mesh->elem = calloc((size_t)4 * n_elems, sizeof *mesh->elem);
+  mesh->region = calloc((size_t)n_elems, sizeof *mesh->region);
+  if (!mesh->xy || !mesh->elem || !mesh->region) {
+    sp_mesh_destroy(&mesh);
+    return sp_error_set(SP_ERR_MEMORY, "out of memory allocating a mesh of "
+                        "%d nodes and %d elements", n_nodes, n_elems);
+  }
+  *out = mesh;
+  return SP_OK;
+}
+
+/** The largest element edge length (sets mesh->h). */
+static void mesh_set_h(sp_mesh *mesh) {
+  double h2 = 0;
+  for (int e = 0; e < mesh->n_elems; ++e) {
+    double xy[4][2];
+    sp_mesh_elem_xy(mesh, e, xy);
+    for (int a = 0; a < 4; ++a) {
+      double dx = xy[(a + 1) % 4][0] - xy[a][0];
+      double dy = xy[(a + 1) % 4][1] - xy[a][1];
+      if (dx * dx + dy * dy > h2) h2 = dx * dx + dy * dy;
+    }
+  }
+  mesh->h = sqrt(h2);
+}
+
+/** x0 + (x1 - x0) i / n, returning x1 exactly for i = n. */
+static double lerp_exact_ends(double x0, double x1, int i, int n) {
+  if (i == n) return x1;
+  return x0 + (x1 - x0) * ((double)i / n);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Rectangle                                                                */
+/* ------------------------------------------------------------------------ */
+
+int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
+                      int ny, sp_mesh **out) {
+  SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_rectangle: out is NULL");
+  *out = NULL;
+  SP_CHECK(nx >= 1, SP_ERR_INPUT, "mesh: nx must be >= 1, got %d", nx);
+  SP_CHECK(ny >= 1, SP_ERR_INPUT, "mesh: ny must be >= 1, got %d", ny);
+  SP_CHECK(isfinite(x0) && isfinite(x1) && x1 > x0, SP_ERR_INPUT,
+           "mesh: need x0 < x1 (finite), got x0 = %g, x1 = %g", x0, x1);
+  SP_CHECK(isfinite(y0) && isfinite(y1) && y1 > y0, SP_ERR_INPUT,
+           "mesh: need y0 < y1 (finite), got y0 = %g, y1 = %g", y0, y1);
+  /* (nx+1)(ny+1) must fit an int, and so must 4 nx ny. */
+  SP_CHECK((double)(nx + 1.0) * (ny + 1.0) < 2.0e9 / 4, SP_ERR_INPUT,
+           "mesh: nx x ny = %d x %d is too large", nx, ny);
+
+  sp_mesh *mesh;
+  SP_CALL(mesh_allocate((nx + 1) * (ny + 1), nx * ny, &mesh));
+  /* Nodes row by row, i fastest: node (i, j) = j (nx+1) + i. */
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) {
+      int node = j * (nx + 1) + i;
+      mesh->xy[2 * node] = lerp_exact_ends(x0, x1, i, nx);
+      mesh->xy[2 * node + 1] = lerp_exact_ends(y0, y1, j, ny);
+    }
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      int *nodes = mesh->elem + 4 * (j * nx + i);
+      nodes[0] = j * (nx + 1) + i; /* counterclockwise from lower left */
+      nodes[1] = nodes[0] + 1;
+      nodes[2] = nodes[1] + nx + 1;
+      nodes[3] = nodes[0] + nx + 1;
+    }
+  /* region[] is already SP_REGION_OMEGA (= 0) from calloc. */
+  mesh->is_ellipse = 0;
+  mesh->bounds[0] = x0;
+  mesh->bounds[1] = y0;
+  mesh->bounds[2] = x1;
+  mesh->bounds[3] = y1;
+  mesh_set_h(mesh);
+  *out = mesh;
+  return SP_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Five-patch disk                                                          */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * Construction ("logical") numbering of the disk's nodes; renumbered at the
+ * end (see disk_ring_order). Square node (i, j), i, j = 0..n: j (n+1) + i.
+ * Ring node (k >= 1, t): (n+1)^2 + (k-1) 4n + t.
+ */
+typedef struct {
+  int n;       /**< elements per patch side, 2^r */
+  int n_rings; /**< n outer-patch rings + buffer rings */
+} disk_grid;
+
+static int disk_square_node(const disk_grid *g, int i, int j) {
+  return j * (g->n + 1) + i;
+}
+
+/**
+ * Node at ring k, angular position t (taken modulo 4n). Ring 0 is the
+ * square's boundary walked counterclockwise from the corner (n, 0): east
+ * edge up, north edge leftwards, west edge down, south edge rightwards.
+ */
+static int disk_ring_node(const disk_grid *g, int k, int t) {
+  int n = g->n;
+  t = ((t % (4 * n)) + 4 * n) % (4 * n);
+  if (k > 0) return (n + 1) * (n + 1) + (k - 1) * 4 * n + t;
+  int side = t / n, step = t % n;
+  switch (side) {
+  case 0: return disk_square_node(g, n, step);
+  case 1: return disk_square_node(g, n - step, n);
+  case 2: return disk_square_node(g, 0, n - step);
+  default: return disk_square_node(g, step, 0);
+  }
+}
+
+/** Rotate (x, y) by quarter_turns * 90 degrees counterclockwise, exactly. */
+static void rotate_quarter_turns(int quarter_turns, double *x, double *y) {
+  for (int q = 0; q < quarter_turns; ++q) {
+    double x_old = *x;
+    *x = -*y;
+    *y = x_old;
+  }
+}
+
+/**
+ * Unit-disk coordinates of ring node (k >= 1, t). Each outer patch is built
+ * in the frame of the east patch and rotated by whole quarter turns, so the
+ * mesh is exactly symmetric under 90-degree rotations (and under the axis
+ * mirrors up to the last bit of cos/sin at +-45 degrees).
+ * In the east frame, local step l = 0..n along the patch maps to the square
+ * point S = (s, s (2l - n)/n) and the circle point C = (cos phi, sin phi),
+ * phi = (pi/4) (2l - n)/n (uniform angles on a 90-degree arc centred on the
+ * axis); ring k <= n is the linear blend (1 - k/n) S + (k/n) C, so ring n
+ * lies exactly on the circle. Buffer ring n + m is C scaled to radius
+ * 1 + m width / layers (uniform radial steps).
+ */
+static void disk_ring_point(const disk_grid *g, int k, int t,
+                            int buffer_layers, double buffer_width,
+                            double *x, double *y) {
+  const double s = SP_MESH_SQUARE_HALF_WIDTH;
+  int n = g->n, patch = t / n, l = t % n;
+  double offset = (double)(2 * l - n) / n; /* in [-1, 1) */
+  double phi = 0.25 * SP_MESH_PI * offset;
+  double cx = cos(phi), cy = sin(phi);
+  if (k <= n) {
+    double eta = (double)k / n;
+    *x = (1 - eta) * s + eta * cx;
+    *y = (1 - eta) * s * offset + eta * cy;
+  } else {
+    double radius = 1 + (k - n) * (buffer_width / buffer_layers);
+    if (k - n == buffer_layers) radius = 1 + buffer_width;
+    *x = radius * cx;
+    *y = radius * cy;
+  }
+  rotate_quarter_turns(patch, x, y);
+}
+
+/** Sort key of a node for the final numbering (see disk_ring_order). */
+typedef struct {
+  long ring;     /**< concentric ring, inside out */
+  long position; /**< counterclockwise position within the ring */
+  int old;       /**< construction index */
+} disk_node_key;
+
+static int disk_key_compare(const void *pa, const void *pb) {
+  const disk_node_key *a = pa, *b = pb;
+  if (a->ring != b->ring) return a->ring < b->ring ? -1 : 1;
+  if (a->position != b->position) return a->position < b->position ? -1 : 1;
+  return (a->old > b->old) - (a->old < b->old);
+}
+
+/**
+ * Position of square node (i, j) on its concentric square ring
+ * m = max(|2i - n|, |2j - n|) (in half-steps; m = n is the square's
+ * boundary), counted counterclockwise from the ring's lower-right corner like
+ * the outer rings' t, in half-steps (even values in [0, 8m)).
+ */
+static long square_ring_position(int n, int i, int j, long m) {
+  long u = 2L * i - n, v = 2L * j - n; /* in [-m, m] */
+  if (m == 0) return 0;
+  if (u == m && v < m) return v + m;               /* east, upwards */
+  if (v == m && u > -m) return 2 * m + (m - u);     /* north, leftwards */
+  if (u == -m && v > -m) return 4 * m + (m - v);    /* west, downwards */
+  return 6 * m + (u + m);                           /* south, rightwards */
+}
+
+/**
+ * Fold a position p in [0, length) of a closed ring so that ring neighbours
+ * stay close: 0, length-1, 1, length-2, ... become 0, 1, 2, 3, ... (the two
+ * halves of the ring interleave, so the wrap-around pair p = 0, length-1 is
+ * no longer length-1 apart).
+ */
+static long ring_fold(long p, long length) {
+  if (length <= 1) return 0; /* the centre node of an even n */
+  return p < length / 2 + length % 2 ? 2 * p : 2 * (length - p) - 1;
+}
+
+/**
+ * Final numbering: concentric rings from the centre outwards (the square's
+ * rings of nodes at Chebyshev distance m from the centre, then the outer
+ * rings k = 1..), each ring folded (ring_fold) from -45 degrees. Every
+ * element couples one ring or two consecutive ones, at matching folded
+ * positions, so the matrix bandwidth is 4n + 2 (one outer ring plus two):
+ * 130 for r = 5, against 255 without folding, 237 for a (y, x) sort, 133 for
+ * reverse Cuthill-McKee and ~(n+1)^2 for the construction numbering. (A
+ * (y, x) sort has the smallest profile, ~23 % below this one; fill-reducing
+ * orderings inside SuperLU/KLU make either fine.) Deterministic: integer keys
+ * only. Fills new_of_old[old] = new.
+ */
+static int disk_ring_order(const disk_grid *g, int n_nodes, int *new_of_old) {
+  int n = g->n;
+  disk_node_key *keys;
+  SP_ALLOC(keys, n_nodes);
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      int old = disk_square_node(g, i, j);
+      long m = labs(2L * i - n) > labs(2L * j - n) ? labs(2L * i - n)
+                                                    : labs(2L * j - n);
+      keys[old].ring = m;
+      keys[old].position =
+          ring_fold(square_ring_position(n, i, j, m), 8 * m);
+      keys[old].old = old;
+    }
+  for (int k = 1; k <= g->n_rings; ++k)
+    for (int t = 0; t < 4 * n; ++t) {
+      int old = disk_ring_node(g, k, t);
+      keys[old].ring = n + k;
+      keys[old].position = ring_fold(t, 4L * n);
+      keys[old].old = old;
+    }
+  qsort(keys, (size_t)n_nodes, sizeof *keys, disk_key_compare);
+  for (int p = 0; p < n_nodes; ++p) new_of_old[keys[p].old] = p;
+  free(keys);
+  return SP_OK;
+}
+
+/** Apply new_of_old to the mesh's node coordinates and connectivity. */
+static int mesh_renumber(sp_mesh *mesh, const int *new_of_old) {
+  double *xy;
+  SP_ALLOC(xy, (size_t)2 * mesh->n_nodes);
+  for (int old = 0; old < mesh->n_nodes; ++old) {
+    xy[2 * new_of_old[old]] = mesh->xy[2 * old];
+    xy[2 * new_of_old[old] + 1] = mesh->xy[2 * old + 1];
+  }
+  free(mesh->xy);
+  mesh->xy = xy;
+  for (long c = 0; c < 4L * mesh->n_elems; ++c)
+    mesh->elem[c] = new_of_old[mesh->elem[c]];
+  return SP_OK;
+}
+
+/** The disk mesh in construction numbering, unit radius, before scaling. */
+static void disk_fill(const disk_grid *g, int buffer_layers,
+                      double buffer_width, sp_mesh *mesh) {
+  const double s = SP_MESH_SQUARE_HALF_WIDTH;
+  int n = g->n;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      int node = disk_square_node(g, i, j);
+      /* s (2i - n)/n: exactly antisymmetric about the centre. */
+      mesh->xy[2 * node] = s * ((double)(2 * i - n) / n);
+      mesh->xy[2 * node + 1] = s * ((double)(2 * j - n) / n);
+    }
+  for (int k = 1; k <= g->n_rings; ++k)
+    for (int t = 0; t < 4 * n; ++t) {
+      int node = disk_ring_node(g, k, t);
+      disk_ring_point(g, k, t, buffer_layers, buffer_width,
+                      &mesh->xy[2 * node], &mesh->xy[2 * node + 1]);
+    }
+
+  int e = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i, ++e) {
+      int *nodes = mesh->elem + 4 * e;
+      nodes[0] = disk_square_node(g, i, j);
+      nodes[1] = disk_square_node(g, i + 1, j);
+      nodes[2] = disk_square_node(g, i + 1, j + 1);
+      nodes[3] = disk_square_node(g, i, j + 1);
+      mesh->region[e] = SP_REGION_OMEGA;
+    }
+  /* Ring elements between rings k and k+1: outward, then along increasing
+   * t, is counterclockwise (e_r x e_theta = +z). */
+  for (int k = 0; k < g->n_rings; ++k)
+    for (int t = 0; t < 4 * n; ++t, ++e) {
+      int *nodes = mesh->elem + 4 * e;
+      nodes[0] = disk_ring_node(g, k, t);
+      nodes[1] = disk_ring_node(g, k + 1, t);
+      nodes[2] = disk_ring_node(g, k + 1, t + 1);
+      nodes[3] = disk_ring_node(g, k, t + 1);
+      mesh->region[e] = k < n ? SP_REGION_OMEGA : SP_REGION_BUFFER;
+    }
+}
+
+int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
+                    double buffer_width, sp_mesh **out) {
+  SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_ellipse: out is NULL");
+  *out = NULL;
+  SP_CHECK(refinements >= 0 && refinements <= SP_MESH_MAX_REFINEMENTS,
+           SP_ERR_INPUT, "mesh: refinements must be in [0, %d], got %d",
+           SP_MESH_MAX_REFINEMENTS, refinements);
+  SP_CHECK(isfinite(a) && a > 0, SP_ERR_INPUT,
+           "mesh: semi-axis a (x) must be positive, got %g", a);
+  SP_CHECK(isfinite(b) && b > 0, SP_ERR_INPUT,
+           "mesh: semi-axis b (y) must be positive, got %g", b);
+  SP_CHECK(buffer_layers >= 0 && buffer_layers <= 1 << SP_MESH_MAX_REFINEMENTS,
+           SP_ERR_INPUT, "mesh: buffer_layers must be in [0, %d], got %d",
+           1 << SP_MESH_MAX_REFINEMENTS, buffer_layers);
+  SP_CHECK(buffer_layers == 0 || (isfinite(buffer_width) && buffer_width > 0),
+           SP_ERR_INPUT, "mesh: buffer_width must be positive when "
+           "buffer_layers = %d > 0, got %g", buffer_layers, buffer_width);
+
+  disk_grid grid = {1 << refinements, (1 << refinements) + buffer_layers};
+  int n = grid.n;
+  int n_nodes = (n + 1) * (n + 1) + 4 * n * grid.n_rings;
+  int n_elems = n * n + 4 * n * grid.n_rings;
+
+  sp_mesh *mesh;
+  SP_CALL(mesh_allocate(n_nodes, n_elems, &mesh));
+  disk_fill(&grid, buffer_layers, buffer_width, mesh);
+
+  int *new_of_old = malloc((size_t)n_nodes * sizeof *new_of_old);
+  int rc = new_of_old ? disk_ring_order(&grid, n_nodes, new_of_old)
+                      : sp_error_set(SP_ERR_MEMORY, "out of memory "
+                                     "renumbering %d mesh nodes", n_nodes);
+  if (rc == SP_OK) rc = mesh_renumber(mesh, new_of_old);
+  free(new_of_old);
+  if (rc != SP_OK) {
+    sp_mesh_destroy(&mesh);
+    return rc;
+  }
+
+  for (int node = 0; node < n_nodes; ++node) {
+    mesh->xy[2 * node] *= a;
+    mesh->xy[2 * node + 1] *= b;
+  }
+  mesh->is_ellipse = 1;
+  mesh->bounds[0] = 0;
+  mesh->bounds[1] = 0;
+  mesh->bounds[2] = a;
+  mesh->bounds[3] = b;
+  mesh_set_h(mesh);
+  *out = mesh;
+  return SP_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Queries                                                                  */
+/* ------------------------------------------------------------------------ */
+
+double sp_mesh_region_area(const sp_mesh *mesh, int region) {
+  if (!mesh) return 0;
+  double area = 0;
+  for (int e = 0; e < mesh->n_elems; ++e) {
+    if (mesh->region[e] != region) continue;
+    double xy[4][2], N[4], dNdx[4][2], x[2], w;
+    sp_mesh_elem_xy(mesh, e, xy);
+    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+      sp_q1_point(xy, q, N, dNdx, x, &w);
+      area += w;
+    }
+  }
+  return area;
+}
+
+int sp_mesh_contains(const sp_mesh *mesh, double x, double y) {
+  if (!mesh) return 0;
+  const double *bd = mesh->bounds;
+  if (mesh->is_ellipse) {
+    double u = x / bd[2], v = y / bd[3];
+    return u * u + v * v <= 1 + SP_MESH_CONTAINS_TOL;
+  }
+  double tol_x = SP_MESH_CONTAINS_TOL * (bd[2] - bd[0]);
+  double tol_y = SP_MESH_CONTAINS_TOL * (bd[3] - bd[1]);
+  return x >= bd[0] - tol_x && x <= bd[2] + tol_x && y >= bd[1] - tol_y &&
+         y <= bd[3] + tol_y;
+}
+
+void sp_mesh_destroy(sp_mesh **mesh) {
+  if (!mesh || !*mesh) return;
+  free((*mesh)->xy);
+  free((*mesh)->elem);
+  free((*mesh)->region);
+  free(*mesh);
+  *mesh = NULL;
+}

@@ -1,0 +1,540 @@
+/**
+ * @file output.c
+ * @brief A run's output directory: CSV append-logs (energy.csv, cells.csv)
+ *        and VTK XML fields (one .vtu per output time, listed in fields.pvd).
+ *
+ * The CSV logs stay open and are flushed after every row, so a crash loses at
+ * most the row being written. Every other file is written to "<path>.tmp" in
+ * the same directory and renamed over <path>: rename within one file system
+ * is atomic, so a reader (ParaView, a plotting script, a restart) never sees a
+ * half-written file.
+ *
+ * The .vtu files use VTK's inline base64 "binary" encoding: with 100k nodes
+ * and 16 cells, ASCII at round-trip precision would be ~80 MB per output,
+ * base64 of the raw doubles is ~34 MB and still exact. Everything is streamed
+ * node by node, so no array of the whole output is held in memory.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "output.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#include "error.h"
+
+struct sp_output_s {
+  char *dir;
+  char *energy_path, *cells_path;
+  FILE *energy, *cells;
+  int n_fields, cap_fields;
+  int *field_step;      /**< step of each .vtu written, in write order */
+  double *field_t;      /**< its time */
+};
+
+/* ------------------------------------------------------------------------ */
+/* Small helpers                                                            */
+/* ------------------------------------------------------------------------ */
+
+/** malloc'd printf; NULL when out of memory. */
+static char *sp_strfmt(const char *fmt, ...)
+    __attribute__((format(printf, 1, 2)));
+static char *sp_strfmt(const char *fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  int n = vsnprintf(NULL, 0, fmt, ap);
+  va_end(ap);
+  if (n < 0) return NULL;
+  char *s = malloc((size_t)n + 1);
+  if (!s) return NULL;
+  va_start(ap, fmt);
+  vsnprintf(s, (size_t)n + 1, fmt, ap);
+  va_end(ap);
+  return s;
+}
+
+/** A growing text buffer (for the small files built in memory). */
+typedef struct {
+  char *s;
+  size_t len, cap;
+  int oom;
+} sp_strbuf;
+
+static void sp_strbuf_add(sp_strbuf *b, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static void sp_strbuf_add(sp_strbuf *b, const char *fmt, ...) {
+  if (b->oom) return;
+  va_list ap;
+  va_start(ap, fmt);
+  int n = vsnprintf(NULL, 0, fmt, ap);
+  va_end(ap);
+  if (n < 0) { b->oom = 1; return; }
+  if (b->len + (size_t)n + 1 > b->cap) {
+    size_t cap = b->cap ? b->cap : 256;
+    while (cap < b->len + (size_t)n + 1) cap *= 2;
+    char *s = realloc(b->s, cap);
+    if (!s) { b->oom = 1; return; }
+    b->s = s;
+    b->cap = cap;
+  }
+  va_start(ap, fmt);
+  vsnprintf(b->s + b->len, (size_t)n + 1, fmt, ap);
+  va_end(ap);
+  b->len += (size_t)n;
+}
+
+/** mkdir -p: create @p dir and its missing parents. An existing directory
+ *  is fine; an existing non-directory anywhere on the path is an error. */
+static int sp_mkdir_p(const char *dir) {
+  SP_CHECK(dir && dir[0], SP_ERR_IO, "output directory: empty path");
+  char *p = sp_strfmt("%s", dir);
+  SP_CHECK(p, SP_ERR_MEMORY, "out of memory copying path '%s'", dir);
+  size_t n = strlen(p);
+  while (n > 1 && p[n - 1] == '/') p[--n] = '\0'; /* "a/b/" is "a/b" */
+  /* Walk the components left to right; a leading '/' is not a component. */
+  for (size_t i = 1; i <= n; ++i) {
+    if (i < n && p[i] != '/') continue;
+    char saved = p[i];
+    p[i] = '\0';
+    if (mkdir(p, 0777) != 0) {
+      int err = errno;
+      struct stat st;
+      if (err == EEXIST) {
+        /* Something is there: only a directory (or a link to one) will do. */
+        if (stat(p, &st) != 0 || !S_ISDIR(st.st_mode)) {
+          int rc = sp_error_set(SP_ERR_IO,
+                                "cannot create output directory '%s': '%s' "
+                                "exists and is not a directory (%s)",
+                                dir, p, strerror(ENOTDIR));
+          free(p);
+          return rc;
+        }
+      } else {
+        int rc = sp_error_set(SP_ERR_IO,
+                              "cannot create output directory '%s' (at '%s'): "
+                              "%s", dir, p, strerror(err));
+        free(p);
+        return rc;
+      }
+    }
+    p[i] = saved;
+  }
+  free(p);
+  return SP_OK;
+}
+
+/**
+ * Open "<path>.tmp" for writing. The temporary lives in the same directory
+ * as @p path, so the final rename never crosses file systems.
+ */
+static int sp_tmp_open(const char *path, char **tmp, FILE **f) {
+  *f = NULL;
+  *tmp = sp_strfmt("%s.tmp", path);
+  SP_CHECK(*tmp, SP_ERR_MEMORY, "out of memory naming a temporary for '%s'",
+           path);
+  *f = fopen(*tmp, "wb");
+  if (!*f) {
+    int rc = sp_error_set(SP_ERR_IO, "cannot open '%s' for writing: %s", *tmp,
+                          strerror(errno));
+    free(*tmp);
+    *tmp = NULL;
+    return rc;
+  }
+  return SP_OK;
+}
+
+/**
+ * Close the temporary opened by sp_tmp_open and rename it over @p path.
+ * Write errors are sticky in the FILE (ferror) and buffered data may only
+ * fail at fclose, so both are checked before the rename; on any failure the
+ * temporary is removed and @p path is left as it was. Frees @p tmp.
+ */
+static int sp_tmp_commit(const char *path, char *tmp, FILE *f) {
+  int rc = SP_OK;
+  int bad = ferror(f);
+  int err = bad ? (errno ? errno : EIO) : 0;
+  if (fclose(f) != 0 && !bad) {
+    bad = 1;
+    err = errno;
+  }
+  if (bad) {
+    rc = sp_error_set(SP_ERR_IO, "cannot write '%s': %s", tmp, strerror(err));
+  } else if (rename(tmp, path) != 0) {
+    rc = sp_error_set(SP_ERR_IO, "cannot rename '%s' to '%s': %s", tmp, path,
+                      strerror(errno));
+  }
+  if (rc != SP_OK) remove(tmp);
+  free(tmp);
+  return rc;
+}
+
+int sp_write_file_atomic(const char *path, const char *text, size_t len) {
+  char *tmp;
+  FILE *f;
+  SP_CALL(sp_tmp_open(path, &tmp, &f));
+  if (len) fwrite(text, 1, len, f); /* a short write sets ferror */
+  return sp_tmp_commit(path, tmp, f);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Open, CSV logs, close                                                    */
+/* ------------------------------------------------------------------------ */
+
+/** Flush a log after a row; report a failed row (disk full, ...) by path. */
+static int sp_log_done(FILE *f, const char *path, int printed) {
+  if (printed < 0 || fflush(f) != 0 || ferror(f))
+    return sp_error_set(SP_ERR_IO, "cannot write '%s': %s", path,
+                        strerror(errno ? errno : EIO));
+  return SP_OK;
+}
+
+static int sp_log_open(const char *path, const char *header, FILE **f) {
+  *f = fopen(path, "w");
+  SP_CHECK(*f, SP_ERR_IO, "cannot open '%s' for writing: %s", path,
+           strerror(errno));
+  return sp_log_done(*f, path, fprintf(*f, "%s\n", header));
+}
+
+int sp_output_open(const char *dir, sp_output *out) {
+  *out = NULL;
+  SP_CALL(sp_mkdir_p(dir));
+  struct sp_output_s *o;
+  SP_ALLOC(o, 1);
+  o->dir = sp_strfmt("%s", dir);
+  o->energy_path = sp_strfmt("%s/energy.csv", dir);
+  o->cells_path = sp_strfmt("%s/cells.csv", dir);
+  int rc = SP_OK;
+  if (!o->dir || !o->energy_path || !o->cells_path)
+    rc = sp_error_set(SP_ERR_MEMORY, "out of memory naming files in '%s'",
+                      dir);
+  if (rc == SP_OK)
+    rc = sp_log_open(o->energy_path,
+                     "step,t,dt,newton_its,n_cells,energy,bulk,gradient,"
+                     "repulsion,buffer,shape", &o->energy);
+  if (rc == SP_OK)
+    rc = sp_log_open(o->cells_path, "step,t,cell,mass,xc,yc,I1,I2,angle",
+                     &o->cells);
+  if (rc != SP_OK) {
+    sp_output_close(&o); /* keeps the first error's message */
+    return rc;
+  }
+  *out = o;
+  return SP_OK;
+}
+
+int sp_output_energy(sp_output out, int step, double t, double dt,
+                     int newton_its, int n_cells, const sp_energy_parts *parts,
+                     double shape) {
+  sp_energy_parts p = {0, 0, 0, 0};
+  if (parts) p = *parts;
+  double total = p.bulk + p.gradient + p.repulsion + p.buffer + shape;
+  /* %.17g: every double prints to a string that reads back bit-exact. */
+  int n = fprintf(out->energy,
+                  "%d,%.17g,%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                  step, t, dt, newton_its, n_cells, total, p.bulk, p.gradient,
+                  p.repulsion, p.buffer, shape);
+  return sp_log_done(out->energy, out->energy_path, n);
+}
+
+int sp_output_cells(sp_output out, int step, double t, int n_cells,
+                    const sp_cell_obs *obs) {
+  int n = 0;
+  for (int k = 0; k < n_cells && n >= 0; ++k)
+    n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].I1,
+                obs[k].I2, obs[k].angle);
+  return sp_log_done(out->cells, out->cells_path, n);
+}
+
+const char *sp_output_dir(sp_output out) { return out ? out->dir : NULL; }
+
+int sp_output_close(sp_output *out) {
+  if (!out || !*out) return SP_OK;
+  struct sp_output_s *o = *out;
+  int rc = SP_OK;
+  /* fclose flushes; its failure is the last chance to notice a lost row. */
+  if (o->energy && fclose(o->energy) != 0)
+    rc = sp_error_set(SP_ERR_IO, "cannot close '%s': %s", o->energy_path,
+                      strerror(errno));
+  if (o->cells && fclose(o->cells) != 0 && rc == SP_OK)
+    rc = sp_error_set(SP_ERR_IO, "cannot close '%s': %s", o->cells_path,
+                      strerror(errno));
+  free(o->dir);
+  free(o->energy_path);
+  free(o->cells_path);
+  free(o->field_step);
+  free(o->field_t);
+  free(o);
+  *out = NULL;
+  return rc;
+}
+
+/* ------------------------------------------------------------------------ */
+/* VTK XML fields                                                           */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * Streaming base64 encoder for VTK "binary" inline data. Bytes are grouped
+ * in triplets; the encoded text is buffered and written in blocks.
+ */
+typedef struct {
+  FILE *f;
+  unsigned char in[3];
+  int n_in;
+  char out[4096];
+  size_t n_out;
+} sp_b64;
+
+static const char sp_b64_alphabet[] =
+    "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+static void sp_b64_flush_out(sp_b64 *b) {
+  if (b->n_out) fwrite(b->out, 1, b->n_out, b->f); /* errors: ferror */
+  b->n_out = 0;
+}
+
+/** Emit one quad of characters for the n (1..3) bytes in b->in. */
+static void sp_b64_quad(sp_b64 *b, int n) {
+  unsigned v = (unsigned)b->in[0] << 16 |
+               (unsigned)(n > 1 ? b->in[1] : 0) << 8 |
+               (unsigned)(n > 2 ? b->in[2] : 0);
+  if (b->n_out + 4 > sizeof b->out) sp_b64_flush_out(b);
+  char *o = b->out + b->n_out;
+  o[0] = sp_b64_alphabet[v >> 18 & 63];
+  o[1] = sp_b64_alphabet[v >> 12 & 63];
+  o[2] = n > 1 ? sp_b64_alphabet[v >> 6 & 63] : '=';
+  o[3] = n > 2 ? sp_b64_alphabet[v & 63] : '=';
+  b->n_out += 4;
+}
+
+static void sp_b64_put(sp_b64 *b, const void *data, size_t len) {
+  const unsigned char *p = data;
+  for (size_t i = 0; i < len; ++i) {
+    b->in[b->n_in++] = p[i];
+    if (b->n_in == 3) {
+      sp_b64_quad(b, 3);
+      b->n_in = 0;
+    }
+  }
+}
+
+/** Pad the last partial triplet and write everything out. */
+static void sp_b64_end(sp_b64 *b) {
+  if (b->n_in) sp_b64_quad(b, b->n_in);
+  b->n_in = 0;
+  sp_b64_flush_out(b);
+}
+
+/**
+ * Start a DataArray's data: the UInt64 byte count, then (same base64 run,
+ * as vtkXMLWriter does for uncompressed data) the values.
+ */
+static void sp_b64_begin_array(sp_b64 *b, FILE *f, uint64_t nbytes) {
+  b->f = f;
+  b->n_in = 0;
+  b->n_out = 0;
+  sp_b64_put(b, &nbytes, sizeof nbytes);
+}
+
+static void sp_vtu_array_open(FILE *f, const char *type, const char *name,
+                              int ncomp) {
+  fprintf(f, "        <DataArray type=\"%s\" Name=\"%s\"", type, name);
+  if (ncomp > 1) fprintf(f, " NumberOfComponents=\"%d\"", ncomp);
+  fprintf(f, " format=\"binary\">\n          ");
+}
+
+static void sp_vtu_array_close(FILE *f) { fprintf(f, "\n        </DataArray>\n"); }
+
+/** cell_id of node i: the k (1-based) of the largest c_k > 1/2, else 0. */
+static int32_t sp_node_cell_id(const sp_layout *l, const double *state,
+                               int i) {
+  int32_t id = 0;
+  double best = 0.5;
+  for (int p = l->node_start[i]; p < l->node_start[i + 1]; ++p)
+    if (state[2 * p] > best) { /* strict: ties keep the lower k */
+      best = state[2 * p];
+      id = l->pair_cell[p] + 1;
+    }
+  return id;
+}
+
+/** Write the whole .vtu to @p f (errors are left in ferror(f)). */
+static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
+                         const double *state, int step, double t) {
+  const int nn = mesh->n_nodes, ne = mesh->n_elems;
+  const uint16_t probe = 1;
+  const int little = *(const unsigned char *)&probe == 1;
+  sp_b64 b;
+
+  fprintf(f, "<?xml version=\"1.0\"?>\n"
+             "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+             "byte_order=\"%s\" header_type=\"UInt64\">\n"
+             "  <UnstructuredGrid>\n",
+          little ? "LittleEndian" : "BigEndian");
+  /* TIME and CYCLE let ParaView show the time of a lone .vtu as well. */
+  fprintf(f, "    <FieldData>\n"
+             "      <DataArray type=\"Float64\" Name=\"TIME\" "
+             "NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n"
+             "      <DataArray type=\"Int32\" Name=\"CYCLE\" "
+             "NumberOfTuples=\"1\" format=\"ascii\">%d</DataArray>\n"
+             "    </FieldData>\n",
+          t, step);
+  fprintf(f, "    <Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\">\n", nn,
+          ne);
+
+  /* Point data: c_k, mu_k per cell (0 off the support), then cell_id. */
+  fprintf(f, "      <PointData Scalars=\"cell_id\">\n");
+  for (int k = 0; k < l->n_cells; ++k)
+    for (int field = 0; field < 2; ++field) {
+      char name[32];
+      snprintf(name, sizeof name, "%s_%d", field ? "mu" : "c", k + 1);
+      sp_vtu_array_open(f, "Float64", name, 1);
+      sp_b64_begin_array(&b, f, (uint64_t)nn * sizeof(double));
+      for (int i = 0; i < nn; ++i) {
+        int p = sp_layout_pair(l, k, i);
+        double v = p >= 0 ? state[2 * p + field] : 0.0;
+        sp_b64_put(&b, &v, sizeof v);
+      }
+      sp_b64_end(&b);
+      sp_vtu_array_close(f);
+    }
+  sp_vtu_array_open(f, "Int32", "cell_id", 1);
+  sp_b64_begin_array(&b, f, (uint64_t)nn * sizeof(int32_t));
+  for (int i = 0; i < nn; ++i) {
+    int32_t id = sp_node_cell_id(l, state, i);
+    sp_b64_put(&b, &id, sizeof id);
+  }
+  sp_b64_end(&b);
+  sp_vtu_array_close(f);
+  fprintf(f, "      </PointData>\n");
+
+  fprintf(f, "      <CellData Scalars=\"region\">\n");
+  sp_vtu_array_open(f, "Int32", "region", 1);
+  sp_b64_begin_array(&b, f, (uint64_t)ne * sizeof(int32_t));
+  for (int e = 0; e < ne; ++e) {
+    int32_t r = mesh->region ? mesh->region[e] : 0;
+    sp_b64_put(&b, &r, sizeof r);
+  }
+  sp_b64_end(&b);
+  sp_vtu_array_close(f);
+  fprintf(f, "      </CellData>\n");
+
+  /* Points: 3 components, z = 0 (ParaView wants 3D points). */
+  fprintf(f, "      <Points>\n");
+  sp_vtu_array_open(f, "Float64", "Points", 3);
+  sp_b64_begin_array(&b, f, (uint64_t)nn * 3 * sizeof(double));
+  for (int i = 0; i < nn; ++i) {
+    double x[3] = {mesh->xy[2 * i], mesh->xy[2 * i + 1], 0.0};
+    sp_b64_put(&b, x, sizeof x);
+  }
+  sp_b64_end(&b);
+  sp_vtu_array_close(f);
+  fprintf(f, "      </Points>\n");
+
+  /* Cells: the quads as listed (counterclockwise, as VTK_QUAD wants). */
+  fprintf(f, "      <Cells>\n");
+  sp_vtu_array_open(f, "Int32", "connectivity", 1);
+  sp_b64_begin_array(&b, f, (uint64_t)ne * 4 * sizeof(int32_t));
+  for (int e = 0; e < ne; ++e)
+    for (int a = 0; a < 4; ++a) {
+      int32_t n = mesh->elem[4 * e + a];
+      sp_b64_put(&b, &n, sizeof n);
+    }
+  sp_b64_end(&b);
+  sp_vtu_array_close(f);
+  sp_vtu_array_open(f, "Int64", "offsets", 1);
+  sp_b64_begin_array(&b, f, (uint64_t)ne * sizeof(int64_t));
+  for (int e = 0; e < ne; ++e) {
+    int64_t off = 4 * ((int64_t)e + 1);
+    sp_b64_put(&b, &off, sizeof off);
+  }
+  sp_b64_end(&b);
+  sp_vtu_array_close(f);
+  sp_vtu_array_open(f, "UInt8", "types", 1);
+  sp_b64_begin_array(&b, f, (uint64_t)ne);
+  for (int e = 0; e < ne; ++e) {
+    const uint8_t vtk_quad = 9;
+    sp_b64_put(&b, &vtk_quad, 1);
+  }
+  sp_b64_end(&b);
+  sp_vtu_array_close(f);
+  fprintf(f, "      </Cells>\n");
+
+  fprintf(f, "    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
+}
+
+/** Rewrite fields.pvd from the list of .vtu files written so far. */
+static int sp_pvd_write(const struct sp_output_s *o) {
+  sp_strbuf b = {0};
+  sp_strbuf_add(&b, "<?xml version=\"1.0\"?>\n"
+                    "<VTKFile type=\"Collection\" version=\"0.1\" "
+                    "byte_order=\"LittleEndian\">\n  <Collection>\n");
+  for (int i = 0; i < o->n_fields; ++i)
+    sp_strbuf_add(&b, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" "
+                      "file=\"fields_%06d.vtu\"/>\n",
+                  o->field_t[i], o->field_step[i]);
+  sp_strbuf_add(&b, "  </Collection>\n</VTKFile>\n");
+  int rc;
+  char *path = sp_strfmt("%s/fields.pvd", o->dir);
+  if (b.oom || !path)
+    rc = sp_error_set(SP_ERR_MEMORY, "out of memory writing fields.pvd in "
+                      "'%s'", o->dir);
+  else
+    rc = sp_write_file_atomic(path, b.s, b.len);
+  free(path);
+  free(b.s);
+  return rc;
+}
+
+/** Record (step, t); writing the same step again replaces its time (a step
+ *  redone after a failure must not be listed twice). */
+static int sp_fields_record(struct sp_output_s *o, int step, double t) {
+  for (int i = 0; i < o->n_fields; ++i)
+    if (o->field_step[i] == step) {
+      o->field_t[i] = t;
+      return SP_OK;
+    }
+  if (o->n_fields == o->cap_fields) {
+    int cap = o->cap_fields ? 2 * o->cap_fields : 16;
+    int *s = realloc(o->field_step, (size_t)cap * sizeof *s);
+    if (s) o->field_step = s;
+    double *tt = realloc(o->field_t, (size_t)cap * sizeof *tt);
+    if (tt) o->field_t = tt;
+    SP_CHECK(s && tt, SP_ERR_MEMORY, "out of memory listing output files");
+    o->cap_fields = cap;
+  }
+  o->field_step[o->n_fields] = step;
+  o->field_t[o->n_fields] = t;
+  ++o->n_fields;
+  return SP_OK;
+}
+
+int sp_output_fields(sp_output out, const sp_mesh *mesh,
+                     const sp_layout *layout, const double *state, int step,
+                     double t) {
+  SP_CHECK(mesh->n_nodes == layout->n_nodes, SP_ERR_INTERNAL,
+           "output: mesh has %d nodes but layout has %d", mesh->n_nodes,
+           layout->n_nodes);
+  SP_CHECK(step >= 0, SP_ERR_INTERNAL, "output: negative step %d", step);
+  char *path = sp_strfmt("%s/fields_%06d.vtu", out->dir, step);
+  SP_CHECK(path, SP_ERR_MEMORY, "out of memory naming a .vtu in '%s'",
+           out->dir);
+  char *tmp;
+  FILE *f;
+  int rc = sp_tmp_open(path, &tmp, &f);
+  if (rc == SP_OK) {
+    sp_vtu_write(f, mesh, layout, state, step, t);
+    rc = sp_tmp_commit(path, tmp, f);
+  }
+  free(path);
+  SP_CALL(rc);
+  SP_CALL(sp_fields_record(out, step, t));
+  return sp_pvd_write(out);
+}
+

@@ -1,0 +1,57 @@
+/**
+ * @file output.h
+ * @brief A run's output directory: energy.csv, cells.csv, fields.pvd with
+ *        one .vtu per output time. Files are written whole (to a temporary
+ *        name, then renamed), so a crash never leaves a half-written file.
+ */
+#ifndef SP_OUTPUT_H
+#define SP_OUTPUT_H
+
+#include "cells.h"
+#include "layout.h"
+#include "mesh.h"
+#include "softpack_solver.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sp_output_s *sp_output;
+
+/** @brief Create @p dir (and parents) and start the CSV logs with headers. */
+int sp_output_open(const char *dir, sp_output *out);
+
+/** @brief Append one row to energy.csv:
+ *  step,t,dt,newton_its,n_cells,energy,bulk,gradient,repulsion,buffer,shape */
+int sp_output_energy(sp_output out, int step, double t, double dt,
+                     int newton_its, int n_cells, const sp_energy_parts *parts,
+                     double shape);
+
+/** @brief Append one row per cell to cells.csv:
+ *  step,t,cell,mass,xc,yc,I1,I2,angle (cells numbered from 1) */
+int sp_output_cells(sp_output out, int step, double t, int n_cells,
+                    const sp_cell_obs *obs);
+
+/**
+ * @brief Write fields_<step>.vtu (unstructured grid of quads; point arrays
+ *        c_k and mu_k per cell, 0 outside a cell's support, and cell_id = the
+ *        k (from 1) with the largest c_k where that c_k > 1/2, else 0) and
+ *        rewrite fields.pvd listing every .vtu written so far with its time.
+ */
+int sp_output_fields(sp_output out, const sp_mesh *mesh,
+                     const sp_layout *layout, const double *state, int step,
+                     double t);
+
+/** @brief The directory path (borrowed). */
+const char *sp_output_dir(sp_output out);
+
+/** @brief Flush and close; *out becomes NULL. */
+int sp_output_close(sp_output *out);
+
+/** @brief Write @p text to @p path atomically (temporary file + rename). */
+int sp_write_file_atomic(const char *path, const char *text, size_t len);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

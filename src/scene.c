@@ -1,0 +1,1080 @@
+/**
+ * @file scene.c
+ * @brief The scene file: one key table, a libcyaml schema built from it,
+ *        range and cross-key validation, `--set` overrides.
+ *
+ * Everything a key is (section, name, type, where it lives in sp_scene,
+ * default, allowed range, unit, meaning) is written once, in sp_keys[]. The
+ * libcyaml schema, the defaults, the checks, the error messages, the
+ * `--set` parser and the documentation table are all derived from it.
+ *
+ * How libcyaml 1.3.1 is used, and why:
+ * - Each section is loaded as an array of void * slots, one per key in table
+ *   order; every key field is CYAML_FLAG_POINTER | CYAML_FLAG_OPTIONAL, so a
+ *   key absent from the file leaves its slot NULL and keeps its default.
+ * - Numbers (float, int, uint keys) are loaded as strings and converted here
+ *   with a strict parser. libcyaml 1.3.1's own scalar readers are lax: its
+ *   FLOAT reader takes "1,5" as 1 and "2e-4s" as 2e-4, its INT reader takes
+ *   "1.5" as 1, and its BOOL reader takes any word it does not know ("maybe")
+ *   as true. A silently misread parameter is worse than a missing line
+ *   number, which is all the string route costs (libcyaml reports lines only
+ *   for what it rejects itself).
+ * - Enums, and booleans (an enum of the YAML 1.1 words true/false, yes/no,
+ *   on/off), are libcyaml ENUMs with CYAML_FLAG_STRICT: libcyaml rejects
+ *   unknown words itself and reports the line.
+ * - Errors: libcyaml logs a message ("Unexpected key: zz", "Invalid ENUM
+ *   value: foo", "libyaml: did not find expected key", ...) followed by a
+ *   backtrace, innermost first, of lines such as
+ *   "  in mapping field 'linear' (line: 12, column: 11)" and
+ *   "  in sequence entry '2' (line: 20, column: 5)" (1-based). A log_fn
+ *   captures those lines; the backtrace is turned into a key path
+ *   (solver.linear, cells[1].x) and the line of the innermost entry.
+ * - `--set section.key=value` values are loaded by libcyaml with the very
+ *   value schema the key has in the file and then go through the same
+ *   conversion and range check, so a value means the same in both places.
+ */
+#include "scene.h"
+
+#include <cyaml/cyaml.h>
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+
+/* ------------------------------------------------------------------------ */
+/* The key table                                                            */
+/* ------------------------------------------------------------------------ */
+
+/** Sections of a scene file, in the order they are documented. */
+typedef enum {
+  SP_SEC_MESH,
+  SP_SEC_MODEL,
+  SP_SEC_TIME,
+  SP_SEC_NOISE,
+  SP_SEC_SOLVER,
+  SP_SEC_OUTPUT,
+  SP_SEC_CELLS, /**< a sequence of cell mappings, not a mapping of scalars */
+  SP_N_SECTIONS
+} sp_section;
+
+static const char *const sp_section_names[SP_N_SECTIONS] = {
+    "mesh", "model", "time", "noise", "solver", "output", "cells"};
+
+/** Scalar type of a key as the user sees it. */
+typedef enum {
+  SP_KEY_FLOAT, /**< double */
+  SP_KEY_INT,   /**< int (written as an integer-valued number, 1e6 is fine) */
+  SP_KEY_UINT,  /**< unsigned */
+  SP_KEY_BOOL,  /**< int 0/1, written true/false (yes/no, on/off) */
+  SP_KEY_ENUM   /**< int, written as one of a list of words */
+} sp_key_type;
+
+static const char *const sp_key_type_names[] = {"float", "int", "uint",
+                                                 "bool", "enum"};
+
+/** How one end of an allowed range is closed. */
+typedef enum {
+  SP_UNBOUNDED = 0, /**< no limit at this end */
+  SP_INCLUSIVE,     /**< the limit itself is allowed */
+  SP_EXCLUSIVE      /**< the limit itself is not allowed */
+} sp_bound_kind;
+
+typedef struct {
+  sp_bound_kind kind;
+  double value;
+} sp_bound;
+
+/* Range ends, spelt for reading the table (lower: AT_LEAST / ABOVE, upper:
+ * AT_MOST / BELOW). */
+#define UNBOUNDED {SP_UNBOUNDED, 0.0}
+#define AT_LEAST(v) {SP_INCLUSIVE, (v)}
+#define ABOVE(v) {SP_EXCLUSIVE, (v)}
+#define AT_MOST(v) {SP_INCLUSIVE, (v)}
+#define BELOW(v) {SP_EXCLUSIVE, (v)}
+
+/** One key of the scene file. */
+typedef struct {
+  sp_section section;
+  const char *name;
+  sp_key_type type;
+  size_t offset;   /**< into sp_scene, or into sp_scene_cell for cells keys */
+  double fallback; /**< the default (enum/bool: the value of the word) */
+  int required;    /**< 1: no default, the key must be given (cells only) */
+  sp_bound lower, upper;
+  const cyaml_strval_t *words; /**< enum and bool: the accepted words */
+  unsigned n_words;
+  const char *unit;
+  const char *meaning;
+} sp_key;
+
+static const cyaml_strval_t sp_mesh_words[] = {
+    {"rectangle", SP_MESH_RECTANGLE}, {"ellipse", SP_MESH_ELLIPSE}};
+static const cyaml_strval_t sp_profile_words[] = {
+    {"tanh", SP_PROFILE_TANH}, {"sharp", SP_PROFILE_SHARP}};
+static const cyaml_strval_t sp_jacobian_words[] = {
+    {"ad", SP_JAC_AD}, {"hand", SP_JAC_HAND}, {"fd", SP_JAC_FD}};
+static const cyaml_strval_t sp_linear_words[] = {
+    {"superlu", SP_LINEAR_SUPERLU},
+    {"superlu_dist", SP_LINEAR_SUPERLU_DIST},
+    {"mumps", SP_LINEAR_MUMPS},
+    {"klu2", SP_LINEAR_KLU2}};
+/* The YAML 1.1 booleans; the first word of each value is the one printed. */
+static const cyaml_strval_t sp_bool_words[] = {
+    {"true", 1}, {"false", 0}, {"yes", 1}, {"no", 0}, {"on", 1}, {"off", 0}};
+
+/* Enum keys are stored through an int *: every enum of scene.h must be
+ * int-sized (GCC and Clang make them unsigned int, which may alias int). */
+_Static_assert(sizeof(sp_mesh_kind) == sizeof(int), "enum size");
+_Static_assert(sizeof(sp_profile_kind) == sizeof(int), "enum size");
+_Static_assert(sizeof(sp_jacobian_kind) == sizeof(int), "enum size");
+_Static_assert(sizeof(sp_linear_kind) == sizeof(int), "enum size");
+
+/* Offset of a member, which must have C type ctype: a table entry whose
+ * type does not match its struct member fails to compile. */
+#define MEMBER_OFFSET(strct, member, ctype)                                    \
+  (offsetof(strct, member) +                                                   \
+   0 * sizeof(_Generic(((strct *)0)->member, ctype: 0)))
+#define ENUM_MEMBER_OFFSET(strct, member)                                      \
+  (offsetof(strct, member) +                                                   \
+   0 * sizeof(char[sizeof(((strct *)0)->member) == sizeof(int) ? 1 : -1]))
+
+#define KEY_FLOAT(sec, name, member, def, lo, hi, unit, meaning)               \
+  {sec, name, SP_KEY_FLOAT, MEMBER_OFFSET(sp_scene, member, double), def, 0,   \
+   lo, hi, NULL, 0, unit, meaning}
+#define KEY_INT(sec, name, member, def, lo, hi, unit, meaning)                 \
+  {sec, name, SP_KEY_INT, MEMBER_OFFSET(sp_scene, member, int), def, 0, lo,    \
+   hi, NULL, 0, unit, meaning}
+#define KEY_UINT(sec, name, member, def, lo, hi, unit, meaning)                \
+  {sec, name, SP_KEY_UINT, MEMBER_OFFSET(sp_scene, member, unsigned), def, 0,  \
+   lo, hi, NULL, 0, unit, meaning}
+#define KEY_BOOL(sec, name, member, def, unit, meaning)                        \
+  {sec, name, SP_KEY_BOOL, MEMBER_OFFSET(sp_scene, member, int), def, 0,       \
+   UNBOUNDED, UNBOUNDED, sp_bool_words, CYAML_ARRAY_LEN(sp_bool_words), unit,  \
+   meaning}
+#define KEY_ENUM(sec, name, member, def, words, unit, meaning)                 \
+  {sec, name, SP_KEY_ENUM, ENUM_MEMBER_OFFSET(sp_scene, member), def, 0,       \
+   UNBOUNDED, UNBOUNDED, words, CYAML_ARRAY_LEN(words), unit, meaning}
+#define CELL_FLOAT_REQUIRED(name, member, lo, hi, unit, meaning)               \
+  {SP_SEC_CELLS, name, SP_KEY_FLOAT,                                           \
+   MEMBER_OFFSET(sp_scene_cell, member, double), 0.0, 1, lo, hi, NULL, 0,      \
+   unit, meaning}
+#define CELL_ENUM(name, member, def, words, unit, meaning)                     \
+  {SP_SEC_CELLS, name, SP_KEY_ENUM, ENUM_MEMBER_OFFSET(sp_scene_cell, member), \
+   def, 0, UNBOUNDED, UNBOUNDED, words, CYAML_ARRAY_LEN(words), unit, meaning}
+
+/* Units: L = the model's length unit, T = its time unit, E = its energy per
+ * unit area (the energy density of Pi); "-" = dimensionless. Defaults are
+ * the paper's values (table 1) where the paper has one. */
+static const sp_key sp_keys[] = {
+    /* mesh */
+    KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
+             "-", "domain Omega: a rectangle or the paper's ellipse"),
+    KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
+              "rectangle: left edge"),
+    KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
+              "rectangle: bottom edge"),
+    KEY_FLOAT(SP_SEC_MESH, "x1", mesh.x1, 1.0, UNBOUNDED, UNBOUNDED, "L",
+              "rectangle: right edge (> x0)"),
+    KEY_FLOAT(SP_SEC_MESH, "y1", mesh.y1, 1.0, UNBOUNDED, UNBOUNDED, "L",
+              "rectangle: top edge (> y0)"),
+    KEY_INT(SP_SEC_MESH, "nx", mesh.nx, 64, AT_LEAST(1), AT_MOST(4096),
+            "elements", "rectangle: elements along x"),
+    KEY_INT(SP_SEC_MESH, "ny", mesh.ny, 64, AT_LEAST(1), AT_MOST(4096),
+            "elements", "rectangle: elements along y"),
+    KEY_INT(SP_SEC_MESH, "refinements", mesh.refinements, 5, AT_LEAST(0),
+            AT_MOST(9), "-",
+            "ellipse: uniform refinements of the five-patch disk "
+            "(5: the paper's 5120 elements)"),
+    KEY_FLOAT(SP_SEC_MESH, "semi_x", mesh.semi_x, 0.5, ABOVE(0.0), UNBOUNDED,
+              "L", "ellipse: semi-axis along x (centred at the origin)"),
+    KEY_FLOAT(SP_SEC_MESH, "semi_y", mesh.semi_y, 0.25, ABOVE(0.0), UNBOUNDED,
+              "L", "ellipse: semi-axis along y"),
+    KEY_INT(SP_SEC_MESH, "buffer_layers", mesh.buffer_layers, 0, AT_LEAST(0),
+            AT_MOST(64), "elements",
+            "ellipse: element rings of the buffer zone outside Omega "
+            "(0: no buffer)"),
+    KEY_FLOAT(SP_SEC_MESH, "buffer_width", mesh.buffer_width, 0.1, ABOVE(0.0),
+              AT_MOST(1.0), "-",
+              "ellipse: radial width of the buffer as a fraction of the "
+              "semi-axes"),
+    /* model */
+    KEY_FLOAT(SP_SEC_MODEL, "alpha", model.alpha, 4.0, ABOVE(0.0), UNBOUNDED,
+              "E", "double-well height: f(c) = alpha c^2 (c-1)^2"),
+    KEY_FLOAT(SP_SEC_MODEL, "kappa", model.kappa, 1e-3, ABOVE(0.0), UNBOUNDED,
+              "E L^2",
+              "gradient energy coefficient; interface width "
+              "d = sqrt(kappa / (2 alpha))"),
+    KEY_FLOAT(SP_SEC_MODEL, "lambda", model.lambda, 100.0, AT_LEAST(0.0),
+              UNBOUNDED, "E", "pair repulsion lambda c_k^2 c_l^2"),
+    KEY_FLOAT(SP_SEC_MODEL, "lambda_b", model.lambda_b, 100.0, AT_LEAST(0.0),
+              UNBOUNDED, "E",
+              "buffer penalty lambda_b c_k^2 in the buffer zone"),
+    KEY_FLOAT(SP_SEC_MODEL, "mobility", model.mobility, 1.0, ABOVE(0.0),
+              UNBOUNDED, "L^2/(E T)", "Cahn-Hilliard mobility M"),
+    /* time */
+    KEY_FLOAT(SP_SEC_TIME, "dt", time.dt, 2e-4, ABOVE(0.0), UNBOUNDED, "T",
+              "base time step dt_bar (backward Euler)"),
+    KEY_FLOAT(SP_SEC_TIME, "t_end", time.t_end, 0.02, ABOVE(0.0), UNBOUNDED,
+              "T", "final time"),
+    KEY_INT(SP_SEC_TIME, "max_steps", time.max_steps, 1000000, AT_LEAST(1),
+            AT_MOST(INT_MAX), "steps", "stop after this many accepted steps"),
+    KEY_FLOAT(SP_SEC_TIME, "dt_min", time.dt_min, 1e-14, ABOVE(0.0),
+              UNBOUNDED, "T",
+              "smallest step tried before the run stops (must be <= dt)"),
+    KEY_FLOAT(SP_SEC_TIME, "shrink", time.shrink, 0.25, ABOVE(0.0),
+              BELOW(1.0), "-", "dt factor after a failed Newton solve"),
+    KEY_FLOAT(SP_SEC_TIME, "grow", time.grow, 2.0, AT_LEAST(1.0), UNBOUNDED,
+              "-", "dt factor after grow_after consecutive successes"),
+    KEY_INT(SP_SEC_TIME, "grow_after", time.grow_after, 3, AT_LEAST(1),
+            AT_MOST(INT_MAX), "steps",
+            "consecutive successful steps before dt grows"),
+    KEY_INT(SP_SEC_TIME, "max_retries", time.max_retries, 30, AT_LEAST(1),
+            AT_MOST(1000), "-",
+            "failed attempts of one step before the run stops"),
+    /* noise */
+    KEY_FLOAT(SP_SEC_NOISE, "background", noise.background, 0.0,
+              AT_LEAST(0.0), AT_MOST(1.0), "-",
+              "initial background value b of every c_k outside its cell"),
+    KEY_FLOAT(SP_SEC_NOISE, "amplitude", noise.amplitude, 0.0, AT_LEAST(0.0),
+              AT_MOST(1.0), "-",
+              "uniform noise amplitude a of the initial fields: "
+              "b + a U(-1, 1)"),
+    KEY_UINT(SP_SEC_NOISE, "seed", noise.seed, 1, AT_LEAST(0),
+             AT_MOST(UINT_MAX), "-",
+             "random seed (a run is reproducible from it)"),
+    /* solver */
+    KEY_ENUM(SP_SEC_SOLVER, "jacobian", solver.jacobian, SP_JAC_AD,
+             sp_jacobian_words, "-",
+             "Newton Jacobian: automatic differentiation, hand-coded or "
+             "finite differences"),
+    KEY_ENUM(SP_SEC_SOLVER, "linear", solver.linear, SP_LINEAR_SUPERLU,
+             sp_linear_words, "-", "direct sparse solver of each Newton step"),
+    KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
+              ABOVE(0.0), BELOW(1.0), "-",
+              "Newton: residual reduction relative to the first residual"),
+    KEY_FLOAT(SP_SEC_SOLVER, "newton_atol", solver.newton_atol, 1e-10,
+              ABOVE(0.0), UNBOUNDED, "-",
+              "Newton: absolute residual (unscaled 2-norm)"),
+    KEY_INT(SP_SEC_SOLVER, "newton_max_its", solver.newton_max_its, 12,
+            AT_LEAST(1), AT_MOST(60), "-",
+            "Newton iterations before a step counts as failed"),
+    /* output */
+    KEY_INT(SP_SEC_OUTPUT, "every", output.every, 10, AT_LEAST(1),
+            AT_MOST(INT_MAX), "steps",
+            "write fields and pictures every this many steps"),
+    KEY_BOOL(SP_SEC_OUTPUT, "pictures", output.pictures, 1, "-",
+             "write PNG pictures"),
+    KEY_INT(SP_SEC_OUTPUT, "picture_width", output.picture_width, 800,
+            AT_LEAST(64), AT_MOST(8192), "px", "picture width"),
+    /* cells: one mapping per initial cell */
+    CELL_FLOAT_REQUIRED("x", x, UNBOUNDED, UNBOUNDED, "L",
+                        "centre x; the cell's disk must lie inside Omega"),
+    CELL_FLOAT_REQUIRED("y", y, UNBOUNDED, UNBOUNDED, "L",
+                        "centre y; the cell's disk must lie inside Omega"),
+    CELL_FLOAT_REQUIRED("radius", radius, ABOVE(0.0), UNBOUNDED, "L",
+                        "radius of the c = 1/2 level set"),
+    CELL_ENUM("profile", profile, SP_PROFILE_TANH, sp_profile_words, "-",
+              "initial profile: tanh (equilibrium width d) or sharp (0/1)"),
+};
+
+#define SP_N_KEYS (sizeof sp_keys / sizeof sp_keys[0])
+
+/** Points on a cell's circle tested against the ellipse (the brief's
+ *  sampling: enough to catch a disk poking out by more than ~0.1% of R). */
+enum { SP_DISK_CHECK_ANGLES = 64 };
+
+/** Room for formatted keys, ranges and libcyaml log lines. */
+enum { SP_TEXT = 256, SP_LIST_TEXT = 512, SP_LOG_LINES = 16 };
+
+/* ------------------------------------------------------------------------ */
+/* Table queries and descriptions                                           */
+/* ------------------------------------------------------------------------ */
+
+/** Position of @p key among the keys of its section: its raw slot. */
+static size_t key_slot(const sp_key *key) {
+  size_t slot = 0;
+  for (const sp_key *k = sp_keys; k != key; ++k)
+    slot += k->section == key->section;
+  return slot;
+}
+
+static size_t section_key_count(sp_section section) {
+  size_t n = 0;
+  for (size_t i = 0; i < SP_N_KEYS; ++i) n += sp_keys[i].section == section;
+  return n;
+}
+
+/** The key named @p name (length @p len) in @p section, or NULL. */
+static const sp_key *find_key(sp_section section, const char *name,
+                              size_t len) {
+  for (size_t i = 0; i < SP_N_KEYS; ++i)
+    if (sp_keys[i].section == section && strlen(sp_keys[i].name) == len &&
+        strncmp(sp_keys[i].name, name, len) == 0)
+      return &sp_keys[i];
+  return NULL;
+}
+
+/** The section named @p name (length @p len), or SP_N_SECTIONS. */
+static sp_section find_section(const char *name, size_t len) {
+  for (int s = 0; s < SP_N_SECTIONS; ++s)
+    if (strlen(sp_section_names[s]) == len &&
+        strncmp(sp_section_names[s], name, len) == 0)
+      return (sp_section)s;
+  return SP_N_SECTIONS;
+}
+
+/** "model.kappa", or "cells[3].x" (cell < 0: "cells[i].x"). */
+static const char *key_path(const sp_key *key, int cell, char *buf,
+                            size_t size) {
+  if (key->section != SP_SEC_CELLS)
+    snprintf(buf, size, "%s.%s", sp_section_names[key->section], key->name);
+  else if (cell >= 0)
+    snprintf(buf, size, "cells[%d].%s", cell, key->name);
+  else
+    snprintf(buf, size, "cells[i].%s", key->name);
+  return buf;
+}
+
+/** The keys of @p section, comma separated (only_required: those only). */
+static const char *section_key_list(sp_section section, int only_required,
+                                    char *buf, size_t size) {
+  size_t used = 0;
+  buf[0] = '\0';
+  for (size_t i = 0; i < SP_N_KEYS && used < size; ++i) {
+    const sp_key *k = &sp_keys[i];
+    if (k->section != section || (only_required && !k->required)) continue;
+    used += (size_t)snprintf(buf + used, size - used, "%s%s",
+                             used ? ", " : "", k->name);
+  }
+  return buf;
+}
+
+static const char *section_list(char *buf, size_t size) {
+  size_t used = 0;
+  buf[0] = '\0';
+  for (int s = 0; s < SP_N_SECTIONS && used < size; ++s)
+    used += (size_t)snprintf(buf + used, size - used, "%s%s",
+                             used ? ", " : "", sp_section_names[s]);
+  return buf;
+}
+
+/** The accepted words of an enum or bool key, comma separated. */
+static const char *word_list(const sp_key *key, char *buf, size_t size) {
+  size_t used = 0;
+  buf[0] = '\0';
+  for (unsigned i = 0; i < key->n_words && used < size; ++i)
+    used += (size_t)snprintf(buf + used, size - used, "%s%s",
+                             used ? ", " : "", key->words[i].str);
+  return buf;
+}
+
+/** The first word naming @p value (enum and bool keys). */
+static const char *word_of(const sp_key *key, double value) {
+  for (unsigned i = 0; i < key->n_words; ++i)
+    if ((double)key->words[i].val == value) return key->words[i].str;
+  return "?";
+}
+
+/** The allowed range: "> 0", ">= 1", "[1, 4096]", "(0, 1)", "any". */
+static const char *range_text(const sp_key *key, char *buf, size_t size) {
+  const sp_bound *lo = &key->lower, *hi = &key->upper;
+  if (lo->kind != SP_UNBOUNDED && hi->kind != SP_UNBOUNDED)
+    snprintf(buf, size, "%c%.15g, %.15g%c",
+             lo->kind == SP_INCLUSIVE ? '[' : '(', lo->value, hi->value,
+             hi->kind == SP_INCLUSIVE ? ']' : ')');
+  else if (lo->kind != SP_UNBOUNDED)
+    snprintf(buf, size, "%s %.15g", lo->kind == SP_INCLUSIVE ? ">=" : ">",
+             lo->value);
+  else if (hi->kind != SP_UNBOUNDED)
+    snprintf(buf, size, "%s %.15g", hi->kind == SP_INCLUSIVE ? "<=" : "<",
+             hi->value);
+  else
+    snprintf(buf, size, "any");
+  return buf;
+}
+
+/** What a key accepts, for messages: "a number > 0", "one of ad, hand". */
+static const char *expectation(const sp_key *key, char *buf, size_t size) {
+  char words[SP_LIST_TEXT], range[SP_TEXT];
+  static const char *const what[] = {"a number", "an integer",
+                                     "an unsigned integer"};
+  switch (key->type) {
+  case SP_KEY_BOOL:
+  case SP_KEY_ENUM:
+    snprintf(buf, size, "one of %s", word_list(key, words, sizeof words));
+    break;
+  default:
+    range_text(key, range, sizeof range);
+    if (key->lower.kind != SP_UNBOUNDED && key->upper.kind != SP_UNBOUNDED)
+      snprintf(buf, size, "%s in %s", what[key->type], range);
+    else if (key->lower.kind != SP_UNBOUNDED ||
+             key->upper.kind != SP_UNBOUNDED)
+      snprintf(buf, size, "%s %s", what[key->type], range);
+    else
+      snprintf(buf, size, "%s", what[key->type]);
+  }
+  return buf;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Values: parse, check, store                                              */
+/* ------------------------------------------------------------------------ */
+
+/** Strict number: the whole text must be one finite strtod number. */
+static int parse_number(const char *text, double *value) {
+  char *end;
+  if (!text || !*text) return 0;
+  *value = strtod(text, &end);
+  return end != text && *end == '\0' && isfinite(*value);
+}
+
+/** 1 if @p value is allowed for @p key (range; integers: integral). */
+static int value_allowed(const sp_key *key, double value) {
+  if (!isfinite(value)) return 0;
+  if ((key->type == SP_KEY_INT || key->type == SP_KEY_UINT) &&
+      value != floor(value))
+    return 0;
+  const sp_bound *lo = &key->lower, *hi = &key->upper;
+  if (lo->kind == SP_INCLUSIVE && !(value >= lo->value)) return 0;
+  if (lo->kind == SP_EXCLUSIVE && !(value > lo->value)) return 0;
+  if (hi->kind == SP_INCLUSIVE && !(value <= hi->value)) return 0;
+  if (hi->kind == SP_EXCLUSIVE && !(value < hi->value)) return 0;
+  return 1;
+}
+
+/** Write @p value into the member of @p base (sp_scene or sp_scene_cell). */
+static void store_value(void *base, const sp_key *key, double value) {
+  char *member = (char *)base + key->offset;
+  switch (key->type) {
+  case SP_KEY_FLOAT: *(double *)member = value; break;
+  case SP_KEY_UINT: *(unsigned *)member = (unsigned)value; break;
+  default: *(int *)member = (int)value; break; /* int, bool, enum */
+  }
+}
+
+static void store_defaults(void *base, sp_section section) {
+  for (size_t i = 0; i < SP_N_KEYS; ++i)
+    if (sp_keys[i].section == section && !sp_keys[i].required)
+      store_value(base, &sp_keys[i], sp_keys[i].fallback);
+}
+
+/**
+ * @brief Convert one loaded slot (a string for numbers, an int for enum and
+ *        bool keys), check it and store it.
+ * @param where message prefix: the file, or "--set ..."
+ * @param cell the cell index for cells keys, else -1
+ */
+static int store_slot(void *base, const sp_key *key, const void *slot,
+                      const char *where, int cell) {
+  char path[SP_TEXT], expected[SP_LIST_TEXT];
+  double value;
+  const char *text = NULL;
+  if (key->type == SP_KEY_BOOL || key->type == SP_KEY_ENUM) {
+    value = *(const int *)slot;
+  } else {
+    text = slot;
+    if (!parse_number(text, &value))
+      return sp_error_set(SP_ERR_INPUT, "%s: %s: expected %s, got '%s'", where,
+                          key_path(key, cell, path, sizeof path),
+                          expectation(key, expected, sizeof expected), text);
+  }
+  if (!value_allowed(key, value))
+    return sp_error_set(SP_ERR_INPUT, "%s: %s: expected %s, got %s", where,
+                        key_path(key, cell, path, sizeof path),
+                        expectation(key, expected, sizeof expected),
+                        text ? text : word_of(key, value));
+  store_value(base, key, value);
+  return SP_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* The libcyaml schema, built from the table                                */
+/* ------------------------------------------------------------------------ */
+
+/** What libcyaml loads: per section an array of key slots (NULL = absent),
+ *  and the cells as consecutive arrays of cell key slots. */
+typedef struct {
+  void **section[SP_SEC_CELLS];
+  void **cells;
+  uint32_t n_cells;
+} sp_raw_scene;
+
+/** The schema. It points into itself: build it in place, never copy it. */
+typedef struct {
+  /* every section's key fields, each list closed by an end entry */
+  cyaml_schema_field_t key_fields[SP_N_KEYS + SP_N_SECTIONS];
+  cyaml_schema_field_t section_fields[SP_N_SECTIONS + 1];
+  cyaml_schema_value_t cell;
+  cyaml_schema_value_t top;
+} sp_schema;
+
+/** The value schema of one key (a pointer: the slot receives it). */
+static cyaml_schema_value_t key_value_schema(const sp_key *key) {
+  cyaml_schema_value_t v;
+  memset(&v, 0, sizeof v);
+  v.flags = CYAML_FLAG_POINTER;
+  switch (key->type) {
+  case SP_KEY_BOOL:
+    v.flags |= CYAML_FLAG_CASE_INSENSITIVE; /* True, YES as YAML allows */
+    /* fall through */
+  case SP_KEY_ENUM:
+    v.type = CYAML_ENUM;
+    v.flags |= CYAML_FLAG_STRICT; /* words only: no bare numbers */
+    v.data_size = sizeof(int);
+    v.enumeration.strings = key->words;
+    v.enumeration.count = key->n_words;
+    break;
+  default: /* numbers: loaded as text, see the file comment */
+    v.type = CYAML_STRING;
+    v.data_size = sizeof(char *);
+    v.string.min = 0;
+    v.string.max = CYAML_UNLIMITED;
+  }
+  return v;
+}
+
+static void build_schema(sp_schema *schema) {
+  memset(schema, 0, sizeof *schema);
+  size_t n = 0;
+  for (int s = 0; s < SP_N_SECTIONS; ++s) {
+    cyaml_schema_field_t *first = &schema->key_fields[n];
+    size_t slots = 0;
+    for (size_t i = 0; i < SP_N_KEYS; ++i) {
+      const sp_key *key = &sp_keys[i];
+      if (key->section != (sp_section)s) continue;
+      cyaml_schema_field_t *f = &schema->key_fields[n++];
+      f->key = key->name;
+      f->data_offset = (uint32_t)(slots++ * sizeof(void *));
+      f->value = key_value_schema(key);
+      if (!key->required) f->value.flags |= CYAML_FLAG_OPTIONAL;
+    }
+    ++n; /* the zeroed end entry */
+    cyaml_schema_field_t *sf = &schema->section_fields[s];
+    sf->key = sp_section_names[s];
+    if (s == SP_SEC_CELLS) {
+      schema->cell.type = CYAML_MAPPING;
+      schema->cell.flags = CYAML_FLAG_DEFAULT;
+      schema->cell.data_size = (uint32_t)(slots * sizeof(void *));
+      schema->cell.mapping.fields = first;
+      sf->data_offset = offsetof(sp_raw_scene, cells);
+      sf->count_offset = offsetof(sp_raw_scene, n_cells);
+      sf->count_size = sizeof(uint32_t);
+      sf->value.type = CYAML_SEQUENCE;
+      /* cells: absent or empty is reported by sp_scene_load itself */
+      sf->value.flags = CYAML_FLAG_POINTER_NULL | CYAML_FLAG_OPTIONAL;
+      sf->value.data_size = schema->cell.data_size;
+      sf->value.sequence.entry = &schema->cell;
+      sf->value.sequence.min = 0;
+      sf->value.sequence.max = CYAML_UNLIMITED;
+    } else {
+      sf->data_offset = (uint32_t)(offsetof(sp_raw_scene, section) +
+                                   (size_t)s * sizeof(void **));
+      sf->value.type = CYAML_MAPPING;
+      /* a section left empty ("model:") just keeps the defaults */
+      sf->value.flags = CYAML_FLAG_POINTER_NULL | CYAML_FLAG_OPTIONAL;
+      sf->value.data_size = (uint32_t)(slots * sizeof(void *));
+      sf->value.mapping.fields = first;
+    }
+  }
+  schema->top.type = CYAML_MAPPING;
+  schema->top.flags = CYAML_FLAG_POINTER;
+  schema->top.data_size = sizeof(sp_raw_scene);
+  schema->top.mapping.fields = schema->section_fields;
+}
+
+/* ------------------------------------------------------------------------ */
+/* libcyaml errors -> one message naming the key                            */
+/* ------------------------------------------------------------------------ */
+
+/** The log lines libcyaml wrote during one load. */
+typedef struct {
+  char line[SP_LOG_LINES][SP_TEXT];
+  int n;
+} sp_cyaml_log;
+
+static void capture_log(cyaml_log_t level, void *ctx, const char *fmt,
+                        va_list args) {
+  sp_cyaml_log *log = ctx;
+  if (level < CYAML_LOG_ERROR || log->n >= SP_LOG_LINES) return;
+  char *line = log->line[log->n++];
+  vsnprintf(line, SP_TEXT, fmt, args);
+  line[strcspn(line, "\n")] = '\0';
+}
+
+static cyaml_config_t cyaml_config(sp_cyaml_log *log) {
+  cyaml_config_t config;
+  memset(&config, 0, sizeof config);
+  config.log_fn = capture_log;
+  config.log_ctx = log;
+  config.mem_fn = cyaml_mem;
+  config.log_level = CYAML_LOG_ERROR;
+  config.flags = CYAML_CFG_DEFAULT; /* unknown keys are errors */
+  return config;
+}
+
+/** libcyaml's own message (its first log line without "Load: "). */
+static const char *cyaml_message(const sp_cyaml_log *log, cyaml_err_t err) {
+  static const char load_tag[] = "Load: ";
+  const char *message = log->n ? log->line[0] : cyaml_strerror(err);
+  if (strncmp(message, load_tag, sizeof load_tag - 1) == 0)
+    message += sizeof load_tag - 1;
+  return message;
+}
+
+/** Where libcyaml stopped: key path from the backtrace and its line. */
+typedef struct {
+  char path[SP_TEXT];
+  unsigned line; /**< 0: unknown */
+} sp_yaml_where;
+
+/**
+ * @brief Turn the captured backtrace into a key path ("solver.linear",
+ *        "cells[1].x") and the line of its innermost entry.
+ * @param drop_innermost_field for a missing field libcyaml's innermost entry
+ *        is the last field it read in that mapping, not the missing one
+ */
+static void backtrace_where(const sp_cyaml_log *log, int drop_innermost_field,
+                            sp_yaml_where *where) {
+  static const char field_tag[] = "in mapping field '";
+  static const char entry_tag[] = "in sequence entry '";
+  static const char line_tag[] = "(line: ";
+  int innermost = -1, first = log->n;
+  where->path[0] = '\0';
+  where->line = 0;
+  for (int i = 0; i < log->n; ++i)
+    if (strstr(log->line[i], "Backtrace:")) {
+      first = i + 1;
+      break;
+    }
+  if (drop_innermost_field && first < log->n &&
+      strstr(log->line[first], field_tag))
+    ++first;
+  for (int i = log->n - 1; i >= first; --i) { /* outermost first */
+    const char *l = log->line[i], *name;
+    size_t used = strlen(where->path);
+    if ((name = strstr(l, field_tag))) {
+      name += sizeof field_tag - 1;
+      snprintf(where->path + used, sizeof where->path - used, "%s%.*s",
+               used ? "." : "", (int)strcspn(name, "'"), name);
+    } else if ((name = strstr(l, entry_tag))) {
+      /* libcyaml counts entries from 1, the messages from 0 */
+      long entry = strtol(name + sizeof entry_tag - 1, NULL, 10);
+      snprintf(where->path + used, sizeof where->path - used, "[%ld]",
+               entry - 1);
+    }
+    innermost = i;
+  }
+  if (innermost >= 0) {
+    const char *l = strstr(log->line[innermost], line_tag);
+    if (l) where->line = (unsigned)strtoul(l + sizeof line_tag - 1, NULL, 10);
+  }
+}
+
+/** "scene.yaml:12" or "scene.yaml" when the line is unknown. */
+static const char *file_line(const char *file, unsigned line, char *buf,
+                             size_t size) {
+  if (line)
+    snprintf(buf, size, "%s:%u", file, line);
+  else
+    snprintf(buf, size, "%s", file);
+  return buf;
+}
+
+/** What belongs at @p path ("", "model", "cells", "cells[2]",
+ *  "model.kappa", "cells[2].x"), for messages. */
+static const char *path_expectation(const char *path, char *buf,
+                                    size_t size) {
+  char list[SP_LIST_TEXT];
+  size_t head = strcspn(path, ".[");
+  sp_section s = find_section(path, head);
+  if (!*path) {
+    snprintf(buf, size, "a mapping of sections (%s)",
+             section_list(list, sizeof list));
+  } else if (s == SP_N_SECTIONS) {
+    snprintf(buf, size, "a known section");
+  } else if (path[head] == '\0') {
+    if (s == SP_SEC_CELLS)
+      snprintf(buf, size, "a sequence of cells, each a mapping of %s",
+               section_key_list(s, 0, list, sizeof list));
+    else
+      snprintf(buf, size, "a mapping of %s keys (%s)", sp_section_names[s],
+               section_key_list(s, 0, list, sizeof list));
+  } else {
+    const char *name = strrchr(path, '.');
+    const sp_key *key = name ? find_key(s, name + 1, strlen(name + 1)) : NULL;
+    if (key)
+      expectation(key, buf, size);
+    else /* a cells entry itself, "cells[2]" */
+      snprintf(buf, size, "a mapping of %s",
+               section_key_list(s, 0, list, sizeof list));
+  }
+  return buf;
+}
+
+/** The message for a failed cyaml_load_*; returns the error code. */
+static int report_cyaml_error(const char *file, cyaml_err_t err,
+                              const sp_cyaml_log *log) {
+  static const char key_tag[] = "Unexpected key: ";
+  static const char missing_tag[] = "Missing required mapping field: ";
+  static const char seen_tag[] = "Mapping field already seen";
+  char at[SP_TEXT + SP_TEXT], expected[SP_LIST_TEXT], list[SP_LIST_TEXT];
+  sp_yaml_where where;
+  const char *message = cyaml_message(log, err);
+
+  if (err == CYAML_ERR_OOM)
+    return sp_error_set(SP_ERR_MEMORY, "%s: out of memory while loading",
+                        file);
+  if (err == CYAML_ERR_INVALID_KEY) {
+    /* the innermost backtrace entry is the enclosing mapping; libcyaml's
+     * line there is that of the previous value, so no line is given */
+    backtrace_where(log, 0, &where);
+    const char *name = strstr(message, key_tag);
+    name = name ? name + sizeof key_tag - 1 : "?";
+    if (!where.path[0])
+      return sp_error_set(SP_ERR_INPUT,
+                          "%s: %s: unknown section; the sections are %s "
+                          "(libcyaml: %s)",
+                          file, name, section_list(list, sizeof list),
+                          message);
+    sp_section s = find_section(where.path, strcspn(where.path, ".["));
+    return sp_error_set(SP_ERR_INPUT,
+                        "%s: %s.%s: unknown key; %s has %s (libcyaml: %s)",
+                        file, where.path, name,
+                        s == SP_SEC_CELLS ? "a cell" : where.path,
+                        s < SP_N_SECTIONS
+                            ? section_key_list(s, 0, list, sizeof list)
+                            : "no such key",
+                        message);
+  }
+  if (err == CYAML_ERR_MAPPING_FIELD_MISSING) {
+    backtrace_where(log, 1, &where);
+    const char *name = strstr(message, missing_tag);
+    name = name ? name + sizeof missing_tag - 1 : "?";
+    return sp_error_set(SP_ERR_INPUT,
+                        "%s: %s%s%s: missing; every cell needs %s "
+                        "(libcyaml: %s)",
+                        file_line(file, where.line, at, sizeof at),
+                        where.path, where.path[0] ? "." : "", name,
+                        section_key_list(SP_SEC_CELLS, 1, list, sizeof list),
+                        message);
+  }
+  backtrace_where(log, 0, &where);
+  if (err == CYAML_ERR_LIBYAML_PARSER) {
+    /* libcyaml knows only where the last good event was, not the error */
+    if (where.path[0])
+      return sp_error_set(SP_ERR_INPUT,
+                          "%s: malformed YAML in %s, after line %u: %s",
+                          file, where.path, where.line, message);
+    return sp_error_set(SP_ERR_INPUT, "%s: malformed YAML: %s", file,
+                        message);
+  }
+  if (strncmp(message, seen_tag, sizeof seen_tag - 1) == 0)
+    return sp_error_set(SP_ERR_INPUT, "%s: %s: given twice (libcyaml: %s)",
+                        file_line(file, where.line, at, sizeof at),
+                        where.path, message);
+  const char *path = where.path[0] ? where.path : "top level";
+  file_line(file, where.line, at, sizeof at);
+  if (err == CYAML_ERR_INVALID_VALUE || err == CYAML_ERR_UNEXPECTED_EVENT)
+    return sp_error_set(SP_ERR_INPUT, "%s: %s: expected %s (libcyaml: %s)",
+                        at, path,
+                        path_expectation(where.path, expected,
+                                         sizeof expected),
+                        message);
+  if (err == CYAML_ERR_INVALID_ALIAS || err == CYAML_ERR_ALIAS)
+    return sp_error_set(SP_ERR_INPUT, "%s: %s: bad YAML alias (libcyaml: %s)",
+                        at, path, message);
+  /* anything else is a schema or library problem, not the user's */
+  return sp_error_set(SP_ERR_INTERNAL, "%s: libcyaml failed (%s): %s", file,
+                      cyaml_strerror(err), message);
+}
+
+/* ------------------------------------------------------------------------ */
+/* Loading                                                                  */
+/* ------------------------------------------------------------------------ */
+
+/** Read the whole file (libcyaml's own open gives no reason on failure). */
+static int read_file(const char *path, char **text, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  SP_CHECK(f, SP_ERR_INPUT, "%s: cannot open the scene file: %s", path,
+           strerror(errno));
+  size_t size = 0, capacity = BUFSIZ;
+  char *buf = malloc(capacity);
+  while (buf) {
+    size += fread(buf + size, 1, capacity - size, f);
+    if (size < capacity) break;
+    char *bigger = realloc(buf, 2 * capacity);
+    if (!bigger) {
+      free(buf);
+      buf = NULL;
+    } else {
+      buf = bigger;
+      capacity *= 2;
+    }
+  }
+  int failed = !buf || ferror(f);
+  int err = errno;
+  fclose(f);
+  if (!buf)
+    return sp_error_set(SP_ERR_MEMORY, "%s: out of memory reading the file",
+                        path);
+  if (failed) {
+    free(buf);
+    return sp_error_set(SP_ERR_INPUT, "%s: cannot read the scene file: %s",
+                        path, strerror(err));
+  }
+  *text = buf;
+  *len = size;
+  return SP_OK;
+}
+
+/** Defaults, then the values of the loaded file. */
+static int apply_raw(sp_scene *scene, const sp_raw_scene *raw,
+                     const char *file) {
+  for (size_t i = 0; i < SP_N_KEYS; ++i) {
+    const sp_key *key = &sp_keys[i];
+    void **slots = key->section == SP_SEC_CELLS ? NULL
+                                                : raw->section[key->section];
+    if (slots && slots[key_slot(key)])
+      SP_CALL(store_slot(scene, key, slots[key_slot(key)], file, -1));
+  }
+  /* libcyaml loads "cells: []", "cells:" and no cells key alike */
+  SP_CHECK(raw->n_cells > 0, SP_ERR_INPUT,
+           "%s: cells: no cells given (the key is missing or its list is "
+           "empty); a scene needs at least one cell",
+           file);
+  SP_ALLOC(scene->cells, raw->n_cells);
+  scene->n_cells = (int)raw->n_cells;
+  size_t n_cell_keys = section_key_count(SP_SEC_CELLS);
+  for (int c = 0; c < scene->n_cells; ++c) {
+    void **slots = raw->cells + (size_t)c * n_cell_keys;
+    store_defaults(&scene->cells[c], SP_SEC_CELLS);
+    for (size_t i = 0; i < SP_N_KEYS; ++i) {
+      const sp_key *key = &sp_keys[i];
+      if (key->section == SP_SEC_CELLS && slots[key_slot(key)])
+        SP_CALL(store_slot(&scene->cells[c], key, slots[key_slot(key)], file,
+                           c));
+    }
+  }
+  return SP_OK;
+}
+
+static int load_file(sp_scene *scene, const char *path) {
+  char *text;
+  size_t len;
+  SP_CALL(read_file(path, &text, &len));
+  sp_schema schema;
+  build_schema(&schema);
+  sp_cyaml_log log = {.n = 0};
+  cyaml_config_t config = cyaml_config(&log);
+  sp_raw_scene *raw = NULL;
+  cyaml_err_t err = CYAML_OK;
+  if (len > 0)
+    err = cyaml_load_data((const uint8_t *)text, len, &config, &schema.top,
+                          (cyaml_data_t **)&raw, NULL);
+  free(text);
+  if (err != CYAML_OK) return report_cyaml_error(path, err, &log);
+  /* an empty file, or only comments: libcyaml succeeds with no data */
+  SP_CHECK(raw, SP_ERR_INPUT,
+           "%s: cells: missing; the file holds no YAML document (empty or "
+           "only comments) and a scene needs at least one cell",
+           path);
+  int rc = apply_raw(scene, raw, path);
+  cyaml_free(&config, &schema.top, raw, 0);
+  return rc;
+}
+
+/** Apply one "section.key=value" override. */
+static int apply_override(sp_scene *scene, const char *arg) {
+  char where[SP_TEXT + SP_TEXT], list[SP_LIST_TEXT], expected[SP_LIST_TEXT];
+  snprintf(where, sizeof where, "--set %s", arg);
+  const char *eq = strchr(arg, '=');
+  SP_CHECK(eq, SP_ERR_INPUT,
+           "%s: expected section.key=value, but '%s' has no '='", where, arg);
+  size_t name_len = (size_t)(eq - arg);
+  const char *dot = memchr(arg, '.', name_len);
+  SP_CHECK(dot, SP_ERR_INPUT,
+           "%s: %.*s: expected section.key=value (no section given); the "
+           "sections are %s",
+           where, (int)name_len, arg, section_list(list, sizeof list));
+  sp_section s = find_section(arg, (size_t)(dot - arg));
+  SP_CHECK(s != SP_N_SECTIONS, SP_ERR_INPUT,
+           "%s: %.*s: unknown section; the sections are %s", where,
+           (int)name_len, arg, section_list(list, sizeof list));
+  SP_CHECK(s != SP_SEC_CELLS, SP_ERR_INPUT,
+           "%s: %.*s: cells cannot be set from the command line; edit the "
+           "cells list of the scene file",
+           where, (int)name_len, arg);
+  const sp_key *key = find_key(s, dot + 1, (size_t)(eq - dot - 1));
+  SP_CHECK(key, SP_ERR_INPUT, "%s: %.*s: unknown key; %s has %s", where,
+           (int)name_len, arg, sp_section_names[s],
+           section_key_list(s, 0, list, sizeof list));
+
+  /* the value is read by libcyaml as a one-scalar YAML document with the
+   * key's own value schema: the same words and text as in a file */
+  char path[SP_TEXT];
+  key_path(key, -1, path, sizeof path);
+  cyaml_schema_value_t schema = key_value_schema(key);
+  sp_cyaml_log log = {.n = 0};
+  cyaml_config_t config = cyaml_config(&log);
+  void *value = NULL;
+  const char *text = eq + 1;
+  cyaml_err_t err = cyaml_load_data((const uint8_t *)text, strlen(text),
+                                    &config, &schema, &value, NULL);
+  if (err == CYAML_ERR_OOM)
+    return sp_error_set(SP_ERR_MEMORY, "%s: out of memory", where);
+  SP_CHECK(err == CYAML_OK, SP_ERR_INPUT,
+           "%s: %s: expected %s, got '%s' (libcyaml: %s)", where, path,
+           expectation(key, expected, sizeof expected), text,
+           cyaml_message(&log, err));
+  SP_CHECK(value, SP_ERR_INPUT, "%s: %s: expected %s, got nothing", where,
+           path, expectation(key, expected, sizeof expected));
+  int rc = store_slot(scene, key, value, where, -1);
+  cyaml_free(&config, &schema, value, 0);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Checks across keys                                                       */
+/* ------------------------------------------------------------------------ */
+
+static int check_time_and_mesh(const sp_scene *scene, const char *file) {
+  const sp_scene_time *t = &scene->time;
+  SP_CHECK(t->dt_min <= t->dt, SP_ERR_INPUT,
+           "%s: time.dt_min: expected a number <= time.dt = %.15g, got "
+           "%.15g",
+           file, t->dt, t->dt_min);
+  if (scene->mesh.type == SP_MESH_RECTANGLE) {
+    const sp_scene_mesh *m = &scene->mesh;
+    SP_CHECK(m->x1 > m->x0, SP_ERR_INPUT,
+             "%s: mesh.x1: expected a number > mesh.x0 = %.15g, got %.15g",
+             file, m->x0, m->x1);
+    SP_CHECK(m->y1 > m->y0, SP_ERR_INPUT,
+             "%s: mesh.y1: expected a number > mesh.y0 = %.15g, got %.15g",
+             file, m->y0, m->y1);
+  }
+  return SP_OK;
+}
+
+/** (x/a)^2 + (y/b)^2: <= 1 inside the ellipse of the mesh. */
+static double ellipse_level(const sp_scene_mesh *m, double x, double y) {
+  return (x / m->semi_x) * (x / m->semi_x) + (y / m->semi_y) * (y / m->semi_y);
+}
+
+/** Every cell's centre, and its whole disk, inside Omega. */
+static int check_cells(const sp_scene *scene, const char *file) {
+  const sp_scene_mesh *m = &scene->mesh;
+  for (int i = 0; i < scene->n_cells; ++i) {
+    const sp_scene_cell *c = &scene->cells[i];
+    double r = c->radius;
+    if (m->type == SP_MESH_RECTANGLE) {
+      SP_CHECK(c->x >= m->x0 && c->x <= m->x1, SP_ERR_INPUT,
+               "%s: cells[%d].x: the centre x = %.15g is outside the "
+               "rectangle's [mesh.x0, mesh.x1] = [%.15g, %.15g]",
+               file, i, c->x, m->x0, m->x1);
+      SP_CHECK(c->y >= m->y0 && c->y <= m->y1, SP_ERR_INPUT,
+               "%s: cells[%d].y: the centre y = %.15g is outside the "
+               "rectangle's [mesh.y0, mesh.y1] = [%.15g, %.15g]",
+               file, i, c->y, m->y0, m->y1);
+      SP_CHECK(c->x - r >= m->x0 && c->x + r <= m->x1 && c->y - r >= m->y0 &&
+                   c->y + r <= m->y1,
+               SP_ERR_INPUT,
+               "%s: cells[%d].radius: the disk of radius %.15g around "
+               "(%.15g, %.15g) is not inside the rectangle [%.15g, %.15g] x "
+               "[%.15g, %.15g]",
+               file, i, r, c->x, c->y, m->x0, m->x1, m->y0, m->y1);
+    } else {
+      double level = ellipse_level(m, c->x, c->y);
+      SP_CHECK(level <= 1.0, SP_ERR_INPUT,
+               "%s: cells[%d].x, cells[%d].y: the centre (%.15g, %.15g) is "
+               "outside the ellipse (x/%.15g)^2 + (y/%.15g)^2 <= 1 (it gives "
+               "%.6g)",
+               file, i, i, c->x, c->y, m->semi_x, m->semi_y, level);
+      const double full_turn = 2.0 * acos(-1.0);
+      for (int j = 0; j < SP_DISK_CHECK_ANGLES; ++j) {
+        double angle = full_turn * j / SP_DISK_CHECK_ANGLES;
+        double px = c->x + r * cos(angle), py = c->y + r * sin(angle);
+        SP_CHECK(ellipse_level(m, px, py) <= 1.0, SP_ERR_INPUT,
+                 "%s: cells[%d].radius: the disk of radius %.15g around "
+                 "(%.15g, %.15g) is not inside the ellipse with semi-axes "
+                 "(%.15g, %.15g): its point (%.6g, %.6g) is outside",
+                 file, i, r, c->x, c->y, m->semi_x, m->semi_y, px, py);
+      }
+    }
+  }
+  return SP_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Public functions                                                         */
+/* ------------------------------------------------------------------------ */
+
+/** Everything sp_scene_load does to a zeroed scene; the caller frees it on
+ *  failure, so this may return from anywhere. */
+static int fill_scene(sp_scene *scene, const char *path, int n_set,
+                      const char *const *set) {
+  for (int s = 0; s < SP_SEC_CELLS; ++s) store_defaults(scene, (sp_section)s);
+  SP_CALL(load_file(scene, path));
+  for (int i = 0; i < n_set; ++i) SP_CALL(apply_override(scene, set[i]));
+  /* a clash may come from an override: say so in the prefix */
+  char where[SP_TEXT + SP_TEXT];
+  snprintf(where, sizeof where, "%s%s", path,
+           n_set ? " (with its --set overrides)" : "");
+  SP_CALL(check_time_and_mesh(scene, where));
+  SP_CALL(check_cells(scene, where));
+  return SP_OK;
+}
+
+int sp_scene_load(const char *path, int n_set, const char *const *set,
+                  sp_scene **out) {
+  SP_CHECK(path && out && n_set >= 0 && (n_set == 0 || set), SP_ERR_INTERNAL,
+           "sp_scene_load: bad arguments");
+  *out = NULL;
+  sp_scene *scene;
+  SP_ALLOC(scene, 1);
+  int rc = fill_scene(scene, path, n_set, set);
+  if (rc != SP_OK) {
+    sp_scene_destroy(&scene);
+    return rc;
+  }
+  *out = scene;
+  return SP_OK;
+}
+
+double sp_scene_interface_width(const sp_scene *scene) {
+  return sqrt(scene->model.kappa / (2.0 * scene->model.alpha));
+}
+
+void sp_scene_print_keys(FILE *out) {
+  char path[SP_TEXT], range[SP_LIST_TEXT], fallback[SP_TEXT];
+  fprintf(out, "| key | type | unit | default | allowed | meaning |\n"
+               "|---|---|---|---|---|---|\n");
+  for (size_t i = 0; i < SP_N_KEYS; ++i) {
+    const sp_key *key = &sp_keys[i];
+    if (key->type == SP_KEY_BOOL || key->type == SP_KEY_ENUM)
+      word_list(key, range, sizeof range);
+    else
+      range_text(key, range, sizeof range);
+    if (key->required)
+      snprintf(fallback, sizeof fallback, "required");
+    else if (key->type == SP_KEY_BOOL || key->type == SP_KEY_ENUM)
+      snprintf(fallback, sizeof fallback, "%s", word_of(key, key->fallback));
+    else
+      snprintf(fallback, sizeof fallback, "%.15g", key->fallback);
+    fprintf(out, "| `%s` | %s | %s | %s | %s | %s |\n",
+            key_path(key, -1, path, sizeof path),
+            sp_key_type_names[key->type], key->unit, fallback, range,
+            key->meaning);
+  }
+}
+
+void sp_scene_destroy(sp_scene **scene) {
+  if (!scene || !*scene) return;
+  free((*scene)->cells);
+  free(*scene);
+  *scene = NULL;
+}

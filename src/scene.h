@@ -1,0 +1,127 @@
+/**
+ * @file scene.h
+ * @brief The input deck: a YAML scene file read through a libcyaml schema,
+ *        validated (types, ranges, cells inside the domain), with
+ *        `--set section.key=value` overrides. Every key, its unit, default
+ *        and range live in one table in scene.c; docs/scene.md is printed
+ *        from that table (`softpack keys`).
+ */
+#ifndef SP_SCENE_H
+#define SP_SCENE_H
+
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum { SP_MESH_RECTANGLE = 0, SP_MESH_ELLIPSE = 1 } sp_mesh_kind;
+typedef enum { SP_PROFILE_TANH = 0, SP_PROFILE_SHARP = 1 } sp_profile_kind;
+typedef enum { SP_JAC_AD = 0, SP_JAC_HAND = 1, SP_JAC_FD = 2 } sp_jacobian_kind;
+typedef enum {
+  SP_LINEAR_SUPERLU = 0,
+  SP_LINEAR_SUPERLU_DIST = 1,
+  SP_LINEAR_MUMPS = 2,
+  SP_LINEAR_KLU2 = 3
+} sp_linear_kind;
+
+/** mesh: the domain and its discretisation. */
+typedef struct {
+  sp_mesh_kind type;   /**< rectangle | ellipse */
+  double x0, y0, x1, y1; /**< rectangle corners */
+  int nx, ny;          /**< rectangle elements per direction */
+  int refinements;     /**< ellipse: five-patch disk refined r times */
+  double semi_x, semi_y; /**< ellipse semi-axes (x, y) */
+  int buffer_layers;   /**< ellipse: element rings of the buffer (0 = none) */
+  double buffer_width; /**< ellipse: buffer width as a fraction of the axes */
+} sp_scene_mesh;
+
+/** model: the energy and the dynamics (paper table 1). */
+typedef struct {
+  double alpha;    /**< double-well height, f = alpha c^2 (c-1)^2 */
+  double kappa;    /**< gradient energy coefficient */
+  double lambda;   /**< pair repulsion */
+  double lambda_b; /**< buffer-ring penalty */
+  double mobility; /**< M */
+} sp_scene_model;
+
+/** time: backward Euler steps and their control. */
+typedef struct {
+  double dt;        /**< the scene's (base) step dt_bar */
+  double t_end;     /**< final time */
+  int max_steps;    /**< stop after this many accepted steps */
+  double dt_min;    /**< smallest step tried before giving up */
+  double shrink;    /**< dt factor after a failed Newton solve (< 1) */
+  double grow;      /**< dt factor after grow_after successes (> 1) */
+  int grow_after;   /**< consecutive successes before dt grows */
+  int max_retries;  /**< failed attempts of one step before the run stops */
+} sp_scene_time;
+
+/** One initial cell. */
+typedef struct {
+  double x, y;     /**< centre */
+  double radius;   /**< radius of the c = 1/2 level set */
+  sp_profile_kind profile; /**< tanh (equilibrium width) or sharp */
+} sp_scene_cell;
+
+/** noise: the initial background of every field. */
+typedef struct {
+  double background; /**< background value b of c outside cells */
+  double amplitude;  /**< uniform noise amplitude a: b + a U(-1,1) */
+  unsigned seed;     /**< RNG seed (runs are reproducible from it) */
+} sp_scene_noise;
+
+/** solver: Newton and the linear solver. */
+typedef struct {
+  sp_jacobian_kind jacobian;
+  sp_linear_kind linear;
+  double newton_rtol;  /**< relative residual tolerance */
+  double newton_atol;  /**< absolute residual tolerance (unscaled 2-norm) */
+  int newton_max_its;  /**< iterations before a step counts as failed */
+} sp_scene_solver;
+
+/** output: what is written and when. */
+typedef struct {
+  int every;          /**< fields and pictures every this many steps */
+  int pictures;       /**< 1: write PNG pictures */
+  int picture_width;  /**< picture width in pixels */
+} sp_scene_output;
+
+typedef struct sp_scene {
+  sp_scene_mesh mesh;
+  sp_scene_model model;
+  sp_scene_time time;
+  sp_scene_noise noise;
+  sp_scene_solver solver;
+  sp_scene_output output;
+  int n_cells;
+  sp_scene_cell *cells;
+} sp_scene;
+
+/**
+ * @brief Read and validate a scene file, then apply overrides.
+ * @param[in] path the YAML file
+ * @param[in] n_set number of overrides
+ * @param[in] set overrides "section.key=value" (e.g. "time.dt=1e-4")
+ * @param[out] out the scene (free with sp_scene_destroy)
+ * @return SP_OK, or SP_ERR_INPUT with a message naming the key, the line
+ *         where known, and what was expected
+ */
+int sp_scene_load(const char *path, int n_set, const char *const *set,
+                  sp_scene **out);
+
+/** @brief Interface width d = sqrt(kappa / (2 alpha)) of the scene's model. */
+double sp_scene_interface_width(const sp_scene *scene);
+
+/** @brief Print every key (markdown table: key, type, unit, default, range,
+ *         meaning): the source of docs/scene.md. */
+void sp_scene_print_keys(FILE *out);
+
+/** @brief Free the scene and its cells and leave *scene NULL (a NULL
+ *         @p scene or *scene is fine). */
+void sp_scene_destroy(sp_scene **scene);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

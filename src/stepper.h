@@ -1,0 +1,51 @@
+/**
+ * @file stepper.h
+ * @brief The time loop: backward-Euler steps of all cells by Newton, with dt
+ *        control (a failed Newton solve shrinks dt and retries the step; dt
+ *        grows back toward the scene's dt after successes; an unconverged
+ *        step is never accepted), observables and output.
+ */
+#ifndef SP_STEPPER_H
+#define SP_STEPPER_H
+
+#include <mpi.h>
+
+#include "mesh.h"
+#include "scene.h"
+#include "softpack_solver.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** What a run did, for the caller's summary line and for tests. */
+typedef struct {
+  int steps;           /**< accepted steps */
+  int failed_attempts; /**< Newton failures that were retried */
+  long newton_its;     /**< Newton iterations of accepted steps */
+  double t_final;      /**< time reached */
+  double dt_smallest;  /**< smallest accepted dt */
+  double wall_seconds;
+  double t_assembly, t_factor, t_solve; /**< seconds over the run */
+} sp_run_summary;
+
+/** @brief The mesh a scene describes. */
+int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out);
+/** @brief Solver options and model parameters from a scene. */
+void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt);
+void sp_model_from_scene(const sp_scene *scene, sp_model_params *model);
+
+/**
+ * @brief Run a scene into @p out_dir. Everything that can be checked before
+ *        the first step (mesh, solver choice) is checked before @p out_dir is
+ *        created, so bad input leaves nothing behind.
+ * @return SP_OK; SP_ERR_INPUT for bad input; SP_ERR_SOLVER when a step failed
+ *         beyond the retries allowed (the last good state is written first)
+ */
+int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
+                   sp_run_summary *summary);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,61 @@
+/* Shared set-up of the method tests: a solver on a mesh and full layout,
+ * cells as tanh disks, model parameters. */
+#ifndef SP_TEST_FIXTURES_H
+#define SP_TEST_FIXTURES_H
+#include <math.h>
+#include <mpi.h>
+#include <stdlib.h>
+
+#include "cells.h"
+#include "check.h"
+#include "error.h"
+#include "layout.h"
+#include "mesh.h"
+#include "q1.h"
+#include "softpack_solver.h"
+
+/** The paper's parameters (table 1). */
+static inline sp_model_params paper_model(void) {
+  sp_model_params m = {.alpha = 4, .kappa = 1e-3, .lambda = 100, .lambda_b = 100, .mobility = 1};
+  return m;
+}
+
+static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout, int jacobian) {
+  sp_solver_options opt = {.jacobian = jacobian, .linear = SP_SOLVER_SUPERLU,
+                           .newton_rtol = 1e-10, .newton_atol = 1e-11, .newton_max_its = 20};
+  sp_solver s = NULL;
+  if (sp_solver_create(MPI_COMM_WORLD, &opt, &s) != 0) {
+    fprintf(stderr, "sp_solver_create: %s\n", sp_solver_last_error(s));
+    exit(1);
+  }
+  sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
+  sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
+                       layout->pair_cell};
+  if (sp_solver_set_problem(s, &mv, &lv) != 0) {
+    fprintf(stderr, "sp_solver_set_problem: %s\n", sp_solver_last_error(s));
+    exit(1);
+  }
+  return s;
+}
+
+/** c_k = tanh disk of radius R at (x, y) with width d; mu_k = 0. */
+static inline void set_disk(const sp_mesh *mesh, const sp_layout *layout, double *state, int k,
+                            double x, double y, double R, double d) {
+  for (int i = 0; i < mesh->n_nodes; ++i) {
+    int p = sp_layout_pair(layout, k, i);
+    if (p < 0) continue;
+    double r = hypot(mesh->xy[2 * i] - x, mesh->xy[2 * i + 1] - y);
+    state[2 * p] = 1.0 / (1.0 + exp((r - R) / d));
+    state[2 * p + 1] = 0.0;
+  }
+}
+
+static inline double energy_total(sp_solver s, const sp_model_params *m, const double *state) {
+  sp_energy_parts e;
+  if (sp_solver_energy(s, m, state, &e) != 0) {
+    fprintf(stderr, "energy: %s\n", sp_solver_last_error(s));
+    exit(1);
+  }
+  return e.bulk + e.gradient + e.repulsion + e.buffer;
+}
+#endif
