@@ -16,9 +16,18 @@ namespace {
 
 class SuperLU final : public DirectSolver {
  public:
+  static constexpr double kDiagonalPivotThreshold = 1e-3;
+
+  // Ordering and pivoting measured on a 3-cell step (one factorisation,
+  // 14k / 99k unknowns, OpenBLAS): COLAMD with partial pivoting 1.3 s /
+  // 36 s; MMD on A^T A 0.38 s / 10 s; MMD on A^T + A with threshold pivoting
+  // (0.001, diagonal preferred) 0.18 s / 3.5 s, Newton still converging to
+  // |F| ~ 1e-16. The mixed form's diagonal (mass matrices) is a safe pivot.
   SuperLU() {
     set_default_options(&options_);
-    options_.ColPerm = COLAMD;
+    options_.ColPerm = MMD_AT_PLUS_A;
+    options_.SymmetricMode = YES;
+    options_.DiagPivotThresh = kDiagonalPivotThreshold;
     StatInit(&stat_);
   }
   ~SuperLU() override {

@@ -864,8 +864,8 @@ static int apply_raw(sp_scene *scene, const sp_raw_scene *raw,
 }
 
 static int load_file(sp_scene *scene, const char *path) {
-  char *text;
-  size_t len;
+  char *text = NULL;
+  size_t len = 0;
   SP_CALL(read_file(path, &text, &len));
   sp_schema schema;
   build_schema(&schema);

@@ -12,10 +12,10 @@ int main(int argc, char **argv) {
   const int n = 2 * layout->n_pairs;
   double *state = calloc(n, sizeof(double)), *old = calloc(n, sizeof(double));
   const double d = sqrt(1e-3 / 8);
-  set_disk(mesh, layout, state, 0, 0.40, 0.45, 0.16, d);
-  set_disk(mesh, layout, state, 1, 0.62, 0.50, 0.14, d);
-  set_disk(mesh, layout, state, 2, 0.50, 0.68, 0.12, d);
-  sp_step_data data = {.dt = 1e-5, .model = paper_model(), .state_old = old};
+  set_disk(mesh, layout, state, 0, 0.36, 0.45, 0.16, d);
+  set_disk(mesh, layout, state, 1, 0.64, 0.50, 0.14, d);
+  set_disk(mesh, layout, state, 2, 0.50, 0.72, 0.12, d);
+  sp_step_data data = {.dt = 1e-6, .model = paper_model(), .state_old = old};
   sp_cell_obs before[3], after[3];
   double worst = 0;
   for (int step = 0; step < 10; ++step) {
