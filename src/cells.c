@@ -65,6 +65,7 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
     const double *s = sums + 7 * k;
     sp_cell_obs *o = obs + k;
     o->mass = s[0];
+    o->mass_core = s[1];
     const double m = s[1] > 0 ? s[1] : 1.0;
     o->xc = s[2] / m;
     o->yc = s[3] / m;

@@ -17,6 +17,8 @@ extern "C" {
 /** Observables of one cell (MODEL.md, shape penalty, for the tensor). */
 typedef struct {
   double mass;      /**< m_k = int c_k dV (the conserved quantity) */
+  double mass_core; /**< int c_k dV over c_k >= weight_threshold only: the
+                         cell without its background (division, source) */
   double xc, yc;    /**< centre of mass int c X / int c */
   double Ixx, Iyy, Ixy; /**< inertia tensor [[Ixx, Ixy],[Ixy, Iyy]] about
                              the centre: Ixx = int c Xb2^2, Iyy = int c Xb1^2,

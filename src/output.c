@@ -31,8 +31,8 @@
 
 struct sp_output_s {
   char *dir;
-  char *energy_path, *cells_path;
-  FILE *energy, *cells;
+  char *energy_path, *cells_path, *divisions_path;
+  FILE *energy, *cells, *divisions;
   int n_fields, cap_fields;
   int *field_step;      /**< step of each .vtu written, in write order */
   double *field_t;      /**< its time */
@@ -209,8 +209,9 @@ int sp_output_open(const char *dir, sp_output *out) {
   o->dir = sp_strfmt("%s", dir);
   o->energy_path = sp_strfmt("%s/energy.csv", dir);
   o->cells_path = sp_strfmt("%s/cells.csv", dir);
+  o->divisions_path = sp_strfmt("%s/divisions.csv", dir);
   int rc = SP_OK;
-  if (!o->dir || !o->energy_path || !o->cells_path)
+  if (!o->dir || !o->energy_path || !o->cells_path || !o->divisions_path)
     rc = sp_error_set(SP_ERR_MEMORY, "out of memory naming files in '%s'",
                       dir);
   if (rc == SP_OK)
@@ -220,6 +221,10 @@ int sp_output_open(const char *dir, sp_output *out) {
   if (rc == SP_OK)
     rc = sp_log_open(o->cells_path, "step,t,cell,mass,xc,yc,I1,I2,angle",
                      &o->cells);
+  if (rc == SP_OK)
+    rc = sp_log_open(o->divisions_path,
+                     "t,step,parent,child,axis_angle,parent_mass_before,"
+                     "parent_mass_after,child_mass_after", &o->divisions);
   if (rc != SP_OK) {
     sp_output_close(&o); /* keeps the first error's message */
     return rc;
@@ -252,6 +257,15 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
   return sp_log_done(out->cells, out->cells_path, n);
 }
 
+int sp_output_division(sp_output out, double t, int step, int parent,
+                       int child, double axis_angle, double mass_before,
+                       double parent_mass_after, double child_mass_after) {
+  int n = fprintf(out->divisions, "%.17g,%d,%d,%d,%.17g,%.17g,%.17g,%.17g\n",
+                  t, step, parent + 1, child + 1, axis_angle, mass_before,
+                  parent_mass_after, child_mass_after);
+  return sp_log_done(out->divisions, out->divisions_path, n);
+}
+
 const char *sp_output_dir(sp_output out) { return out ? out->dir : NULL; }
 
 int sp_output_close(sp_output *out) {
@@ -265,9 +279,13 @@ int sp_output_close(sp_output *out) {
   if (o->cells && fclose(o->cells) != 0 && rc == SP_OK)
     rc = sp_error_set(SP_ERR_IO, "cannot close '%s': %s", o->cells_path,
                       strerror(errno));
+  if (o->divisions && fclose(o->divisions) != 0 && rc == SP_OK)
+    rc = sp_error_set(SP_ERR_IO, "cannot close '%s': %s", o->divisions_path,
+                      strerror(errno));
   free(o->dir);
   free(o->energy_path);
   free(o->cells_path);
+  free(o->divisions_path);
   free(o->field_step);
   free(o->field_t);
   free(o);

@@ -42,6 +42,13 @@ int sp_output_fields(sp_output out, const sp_mesh *mesh,
                      const sp_layout *layout, const double *state, int step,
                      double t);
 
+/** @brief Append one row to divisions.csv: t,step,parent,child,axis_angle,
+ *         parent_mass_before,parent_mass_after,child_mass_after (cells
+ *         numbered from 1; the angle is the division line's, from x). */
+int sp_output_division(sp_output out, double t, int step, int parent,
+                       int child, double axis_angle, double mass_before,
+                       double parent_mass_after, double child_mass_after);
+
 /** @brief The directory path (borrowed). */
 const char *sp_output_dir(sp_output out);
 

@@ -58,12 +58,15 @@ typedef enum {
   SP_SEC_NOISE,
   SP_SEC_SOLVER,
   SP_SEC_OUTPUT,
+  SP_SEC_DIVISION,
+  SP_SEC_SOURCE,
   SP_SEC_CELLS, /**< a sequence of cell mappings, not a mapping of scalars */
   SP_N_SECTIONS
 } sp_section;
 
 static const char *const sp_section_names[SP_N_SECTIONS] = {
-    "mesh", "model", "time", "noise", "solver", "output", "cells"};
+    "mesh", "model", "time", "noise", "solver", "output", "division", "source",
+    "cells"};
 
 /** Scalar type of a key as the user sees it. */
 typedef enum {
@@ -123,6 +126,10 @@ static const cyaml_strval_t sp_linear_words[] = {
     {"superlu_dist", SP_LINEAR_SUPERLU_DIST},
     {"mumps", SP_LINEAR_MUMPS},
     {"klu2", SP_LINEAR_KLU2}};
+static const cyaml_strval_t sp_division_words[] = {
+    {"none", SP_DIVIDE_NONE}, {"age", SP_DIVIDE_BY_AGE}, {"mass", SP_DIVIDE_BY_MASS}};
+static const cyaml_strval_t sp_cut_words[] = {
+    {"sharp", SP_CUT_SHARP}, {"smooth", SP_CUT_SMOOTH}};
 /* The YAML 1.1 booleans; the first word of each value is the one printed. */
 static const cyaml_strval_t sp_bool_words[] = {
     {"true", 1}, {"false", 0}, {"yes", 1}, {"no", 0}, {"on", 1}, {"off", 0}};
@@ -271,6 +278,44 @@ static const sp_key sp_keys[] = {
              "write PNG pictures"),
     KEY_INT(SP_SEC_OUTPUT, "picture_width", output.picture_width, 800,
             AT_LEAST(64), AT_MOST(8192), "px", "picture width"),
+    /* division */
+    KEY_ENUM(SP_SEC_DIVISION, "criterion", division.criterion, SP_DIVIDE_NONE,
+             sp_division_words, "-",
+             "when a cell divides: never, at age t_div, or at mass_ratio x "
+             "its birth mass"),
+    KEY_FLOAT(SP_SEC_DIVISION, "t_div", division.t_div, 0.01, ABOVE(0.0),
+              UNBOUNDED, "T", "age criterion: age at division"),
+    KEY_FLOAT(SP_SEC_DIVISION, "mass_ratio", division.mass_ratio, 2.0,
+              ABOVE(1.0), UNBOUNDED, "-",
+              "mass criterion: divide when m_k reaches this x m_k^0"),
+    KEY_BOOL(SP_SEC_DIVISION, "use_initial_mass", division.use_initial_mass, 0,
+             "-",
+             "mass criterion: m_k^0 is the first cell's birth mass for every "
+             "cell (the authors' code) instead of each cell's own"),
+    KEY_INT(SP_SEC_DIVISION, "max_cells", division.max_cells, 0, AT_LEAST(0),
+            AT_MOST(100000), "cells",
+            "N_max: no division beyond this many cells (0: meas(Omega) / m^0 "
+            "of the first cell)"),
+    KEY_INT(SP_SEC_DIVISION, "n_div", division.n_div, 3, AT_LEAST(0),
+            AT_MOST(100), "steps",
+            "algorithm 2: steps at dt_bar 10^-m after a division"),
+    KEY_INT(SP_SEC_DIVISION, "m", division.m, 6, AT_LEAST(0), AT_MOST(12),
+            "-", "algorithm 2: dt = dt_bar 10^-m (a - n_div)^m while ramping"),
+    KEY_ENUM(SP_SEC_DIVISION, "cut", division.cut, SP_CUT_SHARP, sp_cut_words,
+             "-",
+             "the split: sharp (the paper) or smooth (tanh of the distance "
+             "to the division line, width d)"),
+    KEY_FLOAT(SP_SEC_DIVISION, "observe_threshold", division.observe_threshold,
+              0.05, AT_LEAST(0.0), BELOW(0.5), "-",
+              "centre, inertia and the mass criterion count c_k only where "
+              "c_k >= this, so the background does not count"),
+    /* source */
+    KEY_FLOAT(SP_SEC_SOURCE, "rate", source.rate, 0.0, AT_LEAST(0.0),
+              UNBOUNDED, "1/T",
+              "growth source s_bar inside each cell (the paper: 0 or 5e2)"),
+    KEY_FLOAT(SP_SEC_SOURCE, "off_ratio", source.off_ratio, 1.1, ABOVE(1.0),
+              UNBOUNDED, "-",
+              "a cell's source stops once N >= N_max and m_k / m_k^0 > this"),
     /* cells: one mapping per initial cell */
     CELL_FLOAT_REQUIRED("x", x, UNBOUNDED, UNBOUNDED, "L",
                         "centre x; the cell's disk must lie inside Omega"),

@@ -87,6 +87,33 @@ typedef struct {
   int picture_width;  /**< picture width in pixels */
 } sp_scene_output;
 
+typedef enum {
+  SP_DIVIDE_NONE = 0,
+  SP_DIVIDE_BY_AGE = 1,
+  SP_DIVIDE_BY_MASS = 2
+} sp_division_kind;
+typedef enum { SP_CUT_SHARP = 0, SP_CUT_SMOOTH = 1 } sp_cut_kind;
+
+/** division: when and how cells divide (paper algorithms 1 and 2). */
+typedef struct {
+  sp_division_kind criterion; /**< none | age | mass */
+  double t_div;          /**< age criterion: divide at this age */
+  double mass_ratio;     /**< mass criterion: divide at this x birth mass */
+  int use_initial_mass;  /**< mass criterion against the first cell's mass */
+  int max_cells;         /**< N_max (0: meas(Omega) / birth mass) */
+  int n_div;             /**< algorithm 2: steps at dt_bar 10^-m */
+  int m;                 /**< algorithm 2: exponent */
+  sp_cut_kind cut;       /**< sharp (paper) or smooth (tanh) */
+  double observe_threshold; /**< c below this is left out of centre,
+                                 inertia and the mass criterion */
+} sp_scene_division;
+
+/** source: the adaptive growth source (paper algorithm 3). */
+typedef struct {
+  double rate;      /**< s_bar inside each cell (0: no source) */
+  double off_ratio; /**< switch off once N >= N_max and m/m0 > this */
+} sp_scene_source;
+
 typedef struct sp_scene {
   sp_scene_mesh mesh;
   sp_scene_model model;
@@ -94,6 +121,8 @@ typedef struct sp_scene {
   sp_scene_noise noise;
   sp_scene_solver solver;
   sp_scene_output output;
+  sp_scene_division division;
+  sp_scene_source source;
   int n_cells;
   sp_scene_cell *cells;
 } sp_scene;

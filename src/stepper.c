@@ -7,14 +7,12 @@
 #include <time.h>
 
 #include "cells.h"
+#include "division.h"
 #include "error.h"
 #include "layout.h"
 #include "output.h"
 #include "render.h"
-
-/** Centre and inertia integrate c only where c >= this, so a background
- *  of ~0.02 does not count (as in the authors' code). */
-#define SP_OBSERVABLE_THRESHOLD 0.05
+#include "source.h"
 
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
   const sp_scene_mesh *m = &scene->mesh;
@@ -61,8 +59,26 @@ typedef struct {
   sp_cell_obs *obs;
   double *energy_t, *energy_total; /* the energy history for energy.png */
   int n_energy, cap_energy;
+  double *division_t; /* division times, marked on energy.png */
+  int n_divisions;
   int rank;
+  /* the cell registry */
+  sp_cell_birth *birth;
+  int *source_on;
+  int *division_skipped; /* due but no field left: reported once */
+  double *source;        /* per pair, from c^n */
+  int n_max;             /* N_max */
+  sp_division_params division;
 } sp_run;
+
+/** Observables with the mass replaced by the core mass (c >= threshold):
+ *  what division and source decisions see. */
+static void core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
+  for (int k = 0; k < n; ++k) {
+    out[k] = obs[k];
+    out[k].mass = obs[k].mass_core;
+  }
+}
 
 static int record_energy(sp_run *run, int step, double t, double dt, int its) {
   sp_energy_parts parts;
@@ -81,7 +97,8 @@ static int record_energy(sp_run *run, int step, double t, double dt, int its) {
   }
   run->energy_t[run->n_energy] = t;
   run->energy_total[run->n_energy++] = total;
-  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, SP_OBSERVABLE_THRESHOLD, run->obs));
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
+                           run->scene->division.observe_threshold, run->obs));
   if (run->rank != 0) return SP_OK;
   SP_CALL(sp_output_energy(run->output, step, t, dt, its, run->layout->n_cells, &parts, 0.0));
   SP_CALL(sp_output_cells(run->output, step, t, run->layout->n_cells, run->obs));
@@ -98,33 +115,153 @@ static int write_snapshot(sp_run *run, int step, double t) {
                             run->scene->output.picture_width, path));
   }
   snprintf(path, sizeof path, "%s/energy.png", sp_output_dir(run->output));
-  return sp_render_energy(run->energy_t, run->energy_total, run->n_energy, NULL, 0, path);
+  return sp_render_energy(run->energy_t, run->energy_total, run->n_energy, run->division_t,
+                          run->n_divisions, path);
+}
+
+/** Grow a per-cell array to n entries (new entries zeroed). */
+static int grow_array(void **ptr, size_t elem, int n_old, int n) {
+  void *p = realloc(*ptr, elem * (size_t)n);
+  SP_CHECK(p, SP_ERR_MEMORY, "out of memory for %d cells", n);
+  memset((char *)p + elem * (size_t)n_old, 0, elem * (size_t)(n - n_old));
+  *ptr = p;
+  return SP_OK;
+}
+
+/** Tell the solver about the current layout (rebuilds maps and graph). */
+static int solver_set_layout(sp_run *run) {
+  sp_mesh_view mv = {run->mesh->n_nodes, run->mesh->n_elems, run->mesh->xy,
+                     run->mesh->elem, run->mesh->region};
+  sp_layout_view lv = {run->layout->n_nodes, run->layout->n_cells, run->layout->n_pairs,
+                       run->layout->node_start, run->layout->pair_cell};
+  if (sp_solver_set_problem(run->solver, &mv, &lv) != 0)
+    return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(run->solver));
+  return SP_OK;
+}
+
+/**
+ * Divide cell @p parent (paper algorithm 1): a new layout with one more
+ * cell, the split state on it, the registry entries of both daughters, a
+ * row of divisions.csv.
+ */
+static int divide_cell(sp_run *run, int parent, double t, int step) {
+  const int n = run->layout->n_cells, child = n;
+  sp_layout *new_layout = NULL;
+  SP_CALL(sp_layout_create_full(run->mesh->n_nodes, n + 1, &new_layout));
+  const size_t n_values = 2 * (size_t)new_layout->n_pairs;
+  double *new_state = calloc(n_values, sizeof(double));
+  double *new_old = calloc(n_values, sizeof(double));
+  double *new_source = calloc((size_t)new_layout->n_pairs, sizeof(double));
+  if (!new_state || !new_old || !new_source) {
+    free(new_state); free(new_old); free(new_source);
+    sp_layout_destroy(&new_layout);
+    return sp_error_set(SP_ERR_MEMORY, "out of memory dividing cell %d", parent + 1);
+  }
+  const sp_cell_obs parent_obs = run->obs[parent];
+  const int smooth = run->scene->division.cut == SP_CUT_SMOOTH;
+  int rc = sp_division_split(run->mesh, run->layout, run->state, parent, &parent_obs, smooth,
+                             sp_scene_interface_width(run->scene), new_layout, new_state, child);
+  if (rc != SP_OK) {
+    free(new_state); free(new_old); free(new_source);
+    sp_layout_destroy(&new_layout);
+    return rc;
+  }
+  sp_layout_destroy(&run->layout);
+  free(run->state); free(run->state_old); free(run->source);
+  run->layout = new_layout;
+  run->state = new_state;
+  run->state_old = new_old;
+  run->source = new_source;
+  SP_CALL(grow_array((void **)&run->obs, sizeof *run->obs, n, n + 1));
+  SP_CALL(grow_array((void **)&run->birth, sizeof *run->birth, n, n + 1));
+  SP_CALL(grow_array((void **)&run->source_on, sizeof *run->source_on, n, n + 1));
+  SP_CALL(grow_array((void **)&run->division_skipped, sizeof(int), n, n + 1));
+  run->source_on[child] = run->source_on[parent];
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
+                           run->scene->division.observe_threshold, run->obs));
+  sp_cell_obs *core = malloc(sizeof *core * (size_t)(n + 1));
+  SP_CHECK(core, SP_ERR_MEMORY, "out of memory");
+  core_view(run->obs, n + 1, core);
+  sp_division_record_births(t, core, parent, child, run->birth);
+  free(core);
+  SP_CALL(solver_set_layout(run));
+  double px, py, dx, dy;
+  sp_division_axis(&parent_obs, &px, &py, &dx, &dy);
+  double angle = atan2(dy, dx);
+  if (angle <= -M_PI / 2) angle += M_PI;
+  if (angle > M_PI / 2) angle -= M_PI;
+  SP_CALL(grow_array((void **)&run->division_t, sizeof(double), run->n_divisions,
+                     run->n_divisions + 1));
+  run->division_t[run->n_divisions++] = t;
+  if (run->rank == 0)
+    SP_CALL(sp_output_division(run->output, t, step, parent, child, angle, parent_obs.mass,
+                               run->obs[parent].mass, run->obs[child].mass));
+  return SP_OK;
+}
+
+/** After an accepted step from t_old to t: divide every cell whose
+ *  criterion was crossed. Returns the number of divisions in *n_divided. */
+static int divide_due_cells(sp_run *run, double t_old, double t, int step,
+                            const double *core_mass_old, int *n_divided) {
+  *n_divided = 0;
+  if (run->scene->division.criterion == SP_DIVIDE_NONE) return SP_OK;
+  const int n = run->layout->n_cells; /* daughters born now wait a step */
+  for (int k = 0; k < n; ++k) {
+    if (!sp_division_due(&run->division, &run->birth[k], t_old, t, core_mass_old[k],
+                         run->obs[k].mass_core))
+      continue;
+    if (run->layout->n_cells >= run->n_max) {
+      if (!run->division_skipped[k] && run->rank == 0)
+        fprintf(stderr, "softpack: cell %d is due to divide at t = %.6g but N_max = %d cells "
+                        "exist already; it does not divide\n", k + 1, t, run->n_max);
+      run->division_skipped[k] = 1;
+      continue;
+    }
+    SP_CALL(divide_cell(run, k, t, step));
+    ++*n_divided;
+  }
+  return SP_OK;
 }
 
 /** The time loop proper. */
 static int run_steps(sp_run *run, sp_run_summary *sum) {
   const sp_scene_time *tc = &run->scene->time;
-  const size_t n_values = 2 * (size_t)run->layout->n_pairs;
+  const sp_scene_division *dv = &run->scene->division;
   double t = 0.0, dt = tc->dt;
   int step = 0, successes = 0, failures = 0;
+  int since_division = -1; /* steps since the last division; -1: none yet */
+  double *core_mass_old = NULL;
   sum->dt_smallest = tc->dt;
   SP_CALL(record_energy(run, 0, t, 0.0, 0));
   SP_CALL(write_snapshot(run, 0, t));
   const double t_tol = 1e-12 * tc->t_end;
-  while (t < tc->t_end - t_tol && step < tc->max_steps) {
-    const double dt_try = fmin(dt, tc->t_end - t);
+  int rc = SP_OK;
+  while (rc == SP_OK && t < tc->t_end - t_tol && step < tc->max_steps) {
+    const int n_cells = run->layout->n_cells;
+    const size_t n_values = 2 * (size_t)run->layout->n_pairs;
+    double dt_try = fmin(dt, tc->t_end - t);
+    if (since_division >= 0) /* paper algorithm 2 after a division */
+      dt_try = fmin(dt_try, sp_division_dt(tc->dt, dv->n_div, dv->m, since_division + 1));
     memcpy(run->state_old, run->state, n_values * sizeof(double));
+    if (run->scene->source.rate > 0) {
+      rc = sp_source_fill(run->layout, run->state_old, n_cells, run->source_on,
+                          run->scene->source.rate, run->source);
+      if (rc != SP_OK) break;
+    }
     sp_step_data data = {.dt = dt_try, .model = run->model, .state_old = run->state_old,
-                         .source = NULL, .shape = NULL};
+                         .source = run->scene->source.rate > 0 ? run->source : NULL,
+                         .shape = NULL};
     sp_step_report report;
-    int rc = sp_solver_step(run->solver, &data, run->state, &report);
+    int solved = sp_solver_step(run->solver, &data, run->state, &report);
     sum->t_assembly += report.t_assembly;
     sum->t_factor += report.t_factor;
     sum->t_solve += report.t_solve;
-    if (rc > 1)
-      return sp_error_set(SP_ERR_SOLVER, "step %d at t = %g: %s", step + 1, t,
-                          sp_solver_last_error(run->solver));
-    if (rc == 1) { /* never accept: shrink and retry from the last good state */
+    if (solved > 1) {
+      rc = sp_error_set(SP_ERR_SOLVER, "step %d at t = %g: %s", step + 1, t,
+                        sp_solver_last_error(run->solver));
+      break;
+    }
+    if (solved == 1) { /* never accept: shrink and retry from the last good state */
       memcpy(run->state, run->state_old, n_values * sizeof(double));
       ++failures;
       ++sum->failed_attempts;
@@ -132,32 +269,60 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       dt = dt_try * tc->shrink;
       if (failures > tc->max_retries || dt < tc->dt_min) {
         int rc_out = write_snapshot(run, step, t);
-        sp_error_set(SP_ERR_SOLVER,
-                     "Newton failed on step %d at t = %.6g after %d attempts "
-                     "(last dt = %.3g; time.max_retries = %d, time.dt_min = %.3g): %s. "
-                     "The last good state (t = %.6g) is written%s.",
-                     step + 1, t, failures, dt_try, tc->max_retries, tc->dt_min,
-                     report.reason, t, rc_out == SP_OK ? "" : " (failed: see above)");
-        return SP_ERR_SOLVER;
+        rc = sp_error_set(SP_ERR_SOLVER,
+                          "Newton failed on step %d at t = %.6g after %d attempts "
+                          "(last dt = %.3g; time.max_retries = %d, time.dt_min = %.3g): %s. "
+                          "The last good state (t = %.6g) is written%s.",
+                          step + 1, t, failures, dt_try, tc->max_retries, tc->dt_min,
+                          report.reason, t, rc_out == SP_OK ? "" : " (failed: see above)");
       }
       continue;
     }
+    const double t_old = t;
     t += dt_try;
     ++step;
     failures = 0;
     sum->steps = step;
     sum->newton_its += report.newton_its;
     sum->t_final = t;
+    if (since_division >= 0) ++since_division;
     if (dt_try < sum->dt_smallest) sum->dt_smallest = dt_try;
     if (++successes >= tc->grow_after && dt < tc->dt) {
       dt = fmin(dt * tc->grow, tc->dt);
       successes = 0;
     }
-    SP_CALL(record_energy(run, step, t, dt_try, report.newton_its));
+    /* the core masses before the step, for crossing-safe criteria */
+    double *grown = realloc(core_mass_old, sizeof(double) * (size_t)n_cells);
+    if (!grown) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
+    core_mass_old = grown;
+    for (int k = 0; k < n_cells; ++k) core_mass_old[k] = run->obs[k].mass_core;
+    rc = sp_cells_observe(run->mesh, run->layout, run->state,
+                          run->scene->division.observe_threshold, run->obs);
+    int n_divided = 0;
+    if (rc == SP_OK) rc = divide_due_cells(run, t_old, t, step, core_mass_old, &n_divided);
+    if (rc != SP_OK) break;
+    if (n_divided) {
+      since_division = 0;
+      sum->divisions += n_divided;
+      dt = tc->dt; /* algorithm 2 now sets the pace */
+    }
+    if (run->scene->source.rate > 0) {
+      double *mass = malloc(sizeof(double) * (size_t)run->layout->n_cells);
+      if (!mass) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
+      for (int k = 0; k < run->layout->n_cells; ++k) mass[k] = run->obs[k].mass_core;
+      rc = sp_source_update_switch(run->layout->n_cells, run->n_max, mass, run->birth,
+                                   run->source_on, run->scene->source.off_ratio);
+      free(mass);
+      if (rc != SP_OK) break;
+    }
+    rc = record_energy(run, step, t, dt_try, report.newton_its);
+    if (rc != SP_OK) break;
     const int last = !(t < tc->t_end - t_tol && step < tc->max_steps);
-    if (step % run->scene->output.every == 0 || last) SP_CALL(write_snapshot(run, step, t));
+    if (step % run->scene->output.every == 0 || last || n_divided) rc = write_snapshot(run, step, t);
   }
-  return SP_OK;
+  sum->n_cells = run->layout->n_cells;
+  free(core_mass_old);
+  return rc;
 }
 
 static void run_free(sp_run *run) {
@@ -170,6 +335,11 @@ static void run_free(sp_run *run) {
   free(run->obs);
   free(run->energy_t);
   free(run->energy_total);
+  free(run->division_t);
+  free(run->birth);
+  free(run->source_on);
+  free(run->division_skipped);
+  free(run->source);
 }
 
 static int run_setup(sp_run *run, MPI_Comm comm) {
@@ -189,10 +359,36 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   if (sp_solver_set_problem(run->solver, &mv, &lv) != 0)
     return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(run->solver));
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
+  const int n = scene->n_cells;
   SP_ALLOC(run->state, n_values);
   SP_ALLOC(run->state_old, n_values);
-  SP_ALLOC(run->obs, scene->n_cells);
-  return sp_cells_initial_state(scene, run->mesh, run->layout, run->state);
+  SP_ALLOC(run->source, run->layout->n_pairs);
+  SP_ALLOC(run->obs, n);
+  SP_ALLOC(run->birth, n);
+  SP_ALLOC(run->source_on, n);
+  SP_ALLOC(run->division_skipped, n);
+  SP_CALL(sp_cells_initial_state(scene, run->mesh, run->layout, run->state));
+  /* the registry: every initial cell is born at t = 0 */
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
+                           scene->division.observe_threshold, run->obs));
+  sp_cell_obs *core;
+  SP_ALLOC(core, n);
+  core_view(run->obs, n, core);
+  for (int k = 0; k < n; ++k) {
+    run->birth[k] = sp_cell_birth_make(0.0, &core[k], 0);
+    run->source_on[k] = 1;
+  }
+  free(core);
+  const sp_scene_division *dv = &scene->division;
+  run->n_max = dv->max_cells > 0 ? dv->max_cells
+               : sp_division_max_cells(sp_mesh_region_area(run->mesh, SP_REGION_OMEGA),
+                                       run->birth[0].birth_mass);
+  run->division = (sp_division_params){
+      .criterion = dv->criterion == SP_DIVIDE_BY_AGE ? SP_DIVIDE_AGE : SP_DIVIDE_MASS,
+      .age = dv->t_div, .mass_ratio = dv->mass_ratio,
+      .reference_mass = dv->use_initial_mass ? run->birth[0].birth_mass : 0.0,
+      .tolerance = 0.0};
+  return SP_OK;
 }
 
 int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,

@@ -27,6 +27,8 @@ typedef struct {
   double dt_smallest;  /**< smallest accepted dt */
   double wall_seconds;
   double t_assembly, t_factor, t_solve; /**< seconds over the run */
+  int divisions;       /**< cell divisions */
+  int n_cells;         /**< cells at the end */
 } sp_run_summary;
 
 /** @brief The mesh a scene describes. */
