@@ -14,10 +14,12 @@
 #include <time.h>
 
 #include "cells.h"
+#include "error.h"
 #include "layout.h"
 #include "mesh.h"
 #include "q1.h"
 #include "softpack_solver.h"
+#include "stepper.h"
 
 #define N_CELLS 3
 
@@ -44,11 +46,8 @@ static result run(int n, int steps, double dt) {
   sp_solver_options opt = {.jacobian = SP_SOLVER_JAC_AD, .linear = SP_SOLVER_SUPERLU,
                            .newton_rtol = 1e-8, .newton_atol = 1e-10, .newton_max_its = 12};
   sp_solver s;
-  sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
-  sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
-                       layout->pair_cell};
-  if (sp_solver_create(MPI_COMM_WORLD, &opt, &s) || sp_solver_set_problem(s, &mv, &lv)) {
-    fprintf(stderr, "solver: %s\n", sp_solver_last_error(s));
+  if (sp_solver_create(MPI_COMM_WORLD, &opt, &s) || sp_solver_attach(s, mesh, layout)) {
+    fprintf(stderr, "solver: %s %s\n", sp_solver_last_error(s), sp_error_message());
     exit(1);
   }
   const int nv = 2 * layout->n_pairs;

@@ -20,8 +20,18 @@ extern "C" {
 
 #define SP_MAX_NEWTON_HISTORY 64
 
-/** Jacobian of the element residual. */
-enum { SP_SOLVER_JAC_AD = 0, SP_SOLVER_JAC_HAND = 1, SP_SOLVER_JAC_FD = 2 };
+/**
+ * Jacobian of the element residual: Sacado forward AD (SFad for 1-4 cells on
+ * an element, DFad beyond), hand-derived, or central differences.
+ * SP_SOLVER_JAC_AD_DFAD (DFad at every element size) is for benchmarks and
+ * the comparison entry points only; sp_solver_create does not accept it.
+ */
+enum {
+  SP_SOLVER_JAC_AD = 0,
+  SP_SOLVER_JAC_HAND = 1,
+  SP_SOLVER_JAC_FD = 2,
+  SP_SOLVER_JAC_AD_DFAD = 3
+};
 /** Direct linear solver. */
 enum {
   SP_SOLVER_SUPERLU = 0,
@@ -68,6 +78,9 @@ typedef struct {
   double xc, yc;
   double v[2][2];  /**< unit eigenvectors v_1 (larger moment), v_2 */
   double coef[2];  /**< 2 delta^i (I^i,ref - I^i) */
+  double threshold; /**< the term acts only where c^n >= threshold (at the
+                         quadrature point), as the observables count c only
+                         where c >= their weight threshold */
 } sp_shape_coef;
 
 /** What one backward-Euler step needs besides the state. */
@@ -135,6 +148,28 @@ int sp_solver_residual(sp_solver s, const sp_step_data *data,
 int sp_solver_check_jacobian(sp_solver s, const sp_step_data *data,
                              const double *state, int jacobian,
                              double *max_rel_err);
+
+/**
+ * @brief Compare the element Jacobians of kinds @p kind_a and @p kind_b
+ *        (SP_SOLVER_JAC_*, including SP_SOLVER_JAC_AD_DFAD) at @p state: the
+ *        largest over elements of max|J_a - J_b| / max|J_b|, entries of
+ *        present unknowns only.
+ */
+int sp_solver_compare_jacobians(sp_solver s, const sp_step_data *data,
+                                const double *state, int kind_a, int kind_b,
+                                double *max_rel_diff);
+
+/**
+ * @brief Time the Jacobian fill of kind @p kind at @p state (benchmarks):
+ *        @p repeats fills into a scratch matrix (the solver's own matrix and
+ *        factors are untouched); *seconds_fill is the mean seconds of one
+ *        whole fill (gather, element matrices, insertion, global assembly).
+ *        If @p seconds_elements is not NULL it gets the mean seconds of the
+ *        element matrices alone (gather + element kernel, no insertion).
+ */
+int sp_solver_time_jacobian(sp_solver s, const sp_step_data *data,
+                            const double *state, int kind, int repeats,
+                            double *seconds_fill, double *seconds_elements);
 
 /** @brief The message of the last failed call on @p s. */
 const char *sp_solver_last_error(sp_solver s);

@@ -39,6 +39,13 @@ class Assembly {
   sp_energy_parts energy(const sp_model_params &model, const double *state) const;
   // Largest |J_kind - J_fd| / max|J_fd| over elements (reduced).
   double check_jacobian(const sp_step_data &data, const double *state, int kind) const;
+  // Largest over elements of max|K_a - K_b| / max|K_b| between the element
+  // Jacobians of two kinds, over the entries of present unknowns (reduced).
+  double compare_jacobians(const sp_step_data &data, const double *state, int kind_a,
+                           int kind_b) const;
+  // Gathers and computes every element matrix of this rank without adding
+  // them into a matrix (the element kernel alone, for timing).
+  void element_pass(const sp_step_data &data, const double *state, int kind) const;
 
  private:
   struct Gathered;  // per-element scratch

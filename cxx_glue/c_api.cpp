@@ -34,6 +34,10 @@ void need(bool ok, const char *what) {
   if (!ok) throw std::invalid_argument(what);
 }
 
+bool valid_kind(int kind) {
+  return kind >= SP_SOLVER_JAC_AD && kind <= SP_SOLVER_JAC_AD_DFAD;
+}
+
 }  // namespace
 
 extern "C" {
@@ -92,7 +96,30 @@ int sp_solver_check_jacobian(sp_solver s, const sp_step_data *data, const double
   if (!s) return SP_API_ERR + 1;
   return guarded(s, [&] {
     need(s->impl && data && state && max_rel_err, "sp_solver_check_jacobian: null argument");
+    need(valid_kind(jacobian), "sp_solver_check_jacobian: unknown kind");
     *max_rel_err = s->impl->check_jacobian(*data, state, jacobian);
+  });
+}
+
+int sp_solver_compare_jacobians(sp_solver s, const sp_step_data *data, const double *state,
+                                int kind_a, int kind_b, double *max_rel_diff) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl && data && state && max_rel_diff, "sp_solver_compare_jacobians: null argument");
+    need(valid_kind(kind_a) && valid_kind(kind_b), "sp_solver_compare_jacobians: unknown kind");
+    *max_rel_diff = s->impl->compare_jacobians(*data, state, kind_a, kind_b);
+  });
+}
+
+int sp_solver_time_jacobian(sp_solver s, const sp_step_data *data, const double *state,
+                            int kind, int repeats, double *seconds_fill,
+                            double *seconds_elements) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl && data && state && seconds_fill, "sp_solver_time_jacobian: null argument");
+    need(valid_kind(kind), "sp_solver_time_jacobian: unknown kind");
+    need(repeats >= 1, "sp_solver_time_jacobian: repeats must be >= 1");
+    *seconds_fill = s->impl->time_jacobian(*data, state, kind, repeats, seconds_elements);
   });
 }
 

@@ -309,4 +309,26 @@ double Solver::check_jacobian(const sp_step_data &d, const double *state, int ki
   return assembly_->check_jacobian(d, state, kind);
 }
 
+double Solver::compare_jacobians(const sp_step_data &d, const double *state, int kind_a,
+                                 int kind_b) const {
+  require_problem();
+  return assembly_->compare_jacobians(d, state, kind_a, kind_b);
+}
+
+double Solver::time_jacobian(const sp_step_data &d, const double *state, int kind,
+                             int repeats, double *elements) const {
+  require_problem();
+  if (repeats < 1) throw std::invalid_argument("time_jacobian: repeats must be >= 1");
+  Epetra_FECrsMatrix J(Copy, assembly_->graph());
+  double t0 = now();
+  for (int r = 0; r < repeats; ++r) assembly_->jacobian(d, state, kind, J);
+  const double fill = (now() - t0) / repeats;
+  if (elements) {
+    t0 = now();
+    for (int r = 0; r < repeats; ++r) assembly_->element_pass(d, state, kind);
+    *elements = (now() - t0) / repeats;
+  }
+  return fill;
+}
+
 }  // namespace sp

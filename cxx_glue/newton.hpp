@@ -28,6 +28,12 @@ class Solver {
   sp_energy_parts energy(const sp_model_params &m, const double *state) const;
   void residual(const sp_step_data &data, const double *state, double *residual) const;
   double check_jacobian(const sp_step_data &data, const double *state, int kind) const;
+  double compare_jacobians(const sp_step_data &data, const double *state, int kind_a,
+                           int kind_b) const;
+  // Mean seconds of one Jacobian fill into a scratch matrix, and (if
+  // elements is not null) of the element matrices alone.
+  double time_jacobian(const sp_step_data &data, const double *state, int kind,
+                       int repeats, double *elements) const;
 
   // Called by the NOX interface and linear system (newton.cpp).
   void fill_residual(const sp_step_data &data, const Epetra_Vector &x, Epetra_Vector &F);

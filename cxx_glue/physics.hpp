@@ -27,10 +27,22 @@ S repulsion_d1(const sp_model_params &m, const S &c, const S &sum_sq) {
   return 2.0 * m.lambda * c * (sum_sq - c * c);
 }
 
+// Second derivatives of the repulsion energy (the hand Jacobian):
+// d/dc_k [2 lambda c_k (sum_sq - c_k^2)] = 2 lambda (sum_sq - c_k^2) (the
+// c_k^2 terms cancel: d/dc_k [c_k sum_sq - c_k^3] = sum_sq + 2 c_k^2 - 3 c_k^2),
+// and d/dc_l of the same, l != k, = 4 lambda c_k c_l (symmetric in k, l).
+inline double repulsion_d2_self(const sp_model_params &m, double c, double sum_sq) {
+  return 2.0 * m.lambda * (sum_sq - c * c);
+}
+inline double repulsion_d2_cross(const sp_model_params &m, double c_k, double c_l) {
+  return 4.0 * m.lambda * c_k * c_l;
+}
+
 // Buffer ring penalty lambda_b c^2 per field, derivative 2 lambda_b c.
 template <class S> S buffer_d1(const sp_model_params &m, const S &c) {
   return 2.0 * m.lambda_b * c;
 }
+inline double buffer_d2(const sp_model_params &m) { return 2.0 * m.lambda_b; }
 
 // The explicit shape term's value in mu_k at X: -sum_i coef_i v_i.Ibar(X) v_i
 // with Ibar(X) = [[Xb2^2, -Xb1 Xb2], [-Xb1 Xb2, Xb1^2]] (MODEL.md).

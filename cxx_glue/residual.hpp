@@ -73,7 +73,8 @@ void element_residual(const ElementGeometry &g, int n_cells, const S *u,
       // Everything in mu_k that is not the Laplacian: f', pairs, buffer, shape.
       S local = well_d1(m, c[j]) + repulsion_d1(m, c[j], sum_sq);
       if (g.buffer) local += buffer_d1(m, c[j]);
-      if (in.shape && in.shape[j]) local += shape_mu(*in.shape[j], g.x[q][0], g.x[q][1]);
+      if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
+        local += shape_mu(*in.shape[j], g.x[q][0], g.x[q][1]);
       const S rate = c[j] - c_old - in.dt * s;
       for (int a = 0; a < 4; ++a) {
         const double *dN = g.dNdx[q][a];

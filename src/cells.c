@@ -35,30 +35,25 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
     for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
       double N[4], dNdx[4][2], x[2], w;
       sp_q1_point(xy, q, N, dNdx, x, &w);
-      /* Cells present at the element's nodes. */
-      for (int a = 0; a < 4; ++a)
-        for (int p = layout->node_start[nodes[a]]; p < layout->node_start[nodes[a] + 1]; ++p) {
-          const int k = layout->pair_cell[p];
-          /* Each cell once per point: only from its first node here. */
-          int first = 1;
-          for (int b = 0; b < a; ++b)
-            if (sp_layout_pair(layout, k, nodes[b]) >= 0) first = 0;
-          if (!first) continue;
-          double c = 0;
-          for (int b = 0; b < 4; ++b) {
-            int pb = sp_layout_pair(layout, k, nodes[b]);
-            if (pb >= 0) c += N[b] * state[2 * pb];
-          }
-          double *s = sums + 7 * k;
-          s[0] += w * c;
-          const double cw = c >= weight_threshold ? c : 0.0;
-          s[1] += w * cw;
-          s[2] += w * cw * x[0];
-          s[3] += w * cw * x[1];
-          s[4] += w * cw * x[0] * x[0];
-          s[5] += w * cw * x[1] * x[1];
-          s[6] += w * cw * x[0] * x[1];
-        }
+      /* Cell k lives on the element when all four nodes carry it (the
+       * solver's rule: a field's domain is a union of whole elements). */
+      for (int p0 = layout->node_start[nodes[0]]; p0 < layout->node_start[nodes[0] + 1]; ++p0) {
+        const int k = layout->pair_cell[p0];
+        int pairs[4] = {p0, -1, -1, -1}, whole = 1;
+        for (int b = 1; b < 4 && whole; ++b) whole = (pairs[b] = sp_layout_pair(layout, k, nodes[b])) >= 0;
+        if (!whole) continue;
+        double c = 0;
+        for (int b = 0; b < 4; ++b) c += N[b] * state[2 * pairs[b]];
+        double *s = sums + 7 * k;
+        s[0] += w * c;
+        const double cw = c >= weight_threshold ? c : 0.0;
+        s[1] += w * cw;
+        s[2] += w * cw * x[0];
+        s[3] += w * cw * x[1];
+        s[4] += w * cw * x[0] * x[0];
+        s[5] += w * cw * x[1] * x[1];
+        s[6] += w * cw * x[0] * x[1];
+      }
     }
   }
   for (int k = 0; k < nc; ++k) {

@@ -4,6 +4,7 @@
  *
  *   softpack run SCENE.yaml [--out DIR] [--set section.key=value]...
  *   softpack keys        print every scene key (the table of docs/scene.md)
+ *   softpack check-jacobian SCENE.yaml [--steps K] [--set section.key=value]...
  *   softpack --help
  *
  * Exit status: 0 success, 2 bad input (nothing written), 1 any other failure.
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "checkjac.h"
 #include "error.h"
 #include "scene.h"
 #include "stepper.h"
@@ -21,6 +23,8 @@ static void usage(FILE *to) {
   fprintf(to,
           "usage: softpack run SCENE.yaml [--out DIR] [--set section.key=value]...\n"
           "       softpack keys      print every scene key with unit, default and range\n"
+          "       softpack check-jacobian SCENE.yaml [--steps K] [--set section.key=value]...\n"
+          "                          compare the ad, hand and fd element Jacobians\n"
           "       softpack --help\n"
           "Outputs go to DIR (default out/<scene name>): energy.csv, cells.csv,\n"
           "fields.pvd + fields_*.vtu (ParaView), cells_*.png, energy.png.\n"
@@ -61,6 +65,10 @@ static int cmd_run(int argc, char **argv, int rank) {
   if (rc == SP_OK) rc = sp_scene_load(scene_path, n_set, sets, &scene);
   sp_run_summary sum;
   if (rc == SP_OK) rc = sp_stepper_run(scene, out_dir, MPI_COMM_WORLD, &sum);
+  if (rc == SP_OK && rank == 0 && sum.layout_changes)
+    printf("softpack: local supports: %d changes (%.1f s), largest relative mass change restored "
+           "%.2e, at most %ld unknowns\n",
+           sum.layout_changes, sum.t_layout, sum.support_mass_correction, sum.unknowns_max);
   if (rc == SP_OK && rank == 0)
     printf("softpack: %d steps to t = %.6g (%d failed attempts retried, smallest dt %.3g), "
            "%ld Newton iterations, %.1f s (assembly %.1f, factorisation %.1f, solves %.1f); "
@@ -83,6 +91,8 @@ int main(int argc, char **argv) {
     if (rank == 0) sp_scene_print_keys(stdout);
   } else if (argc >= 2 && strcmp(argv[1], "run") == 0) {
     rc = cmd_run(argc - 2, argv + 2, rank);
+  } else if (argc >= 2 && strcmp(argv[1], "check-jacobian") == 0) {
+    rc = sp_check_jacobian_command(argc - 2, argv + 2);
   } else {
     rc = sp_error_set(SP_ERR_INPUT, "unknown command%s%s (try softpack --help)",
                       argc >= 2 ? ": " : "", argc >= 2 ? argv[1] : "");

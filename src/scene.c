@@ -60,13 +60,15 @@ typedef enum {
   SP_SEC_OUTPUT,
   SP_SEC_DIVISION,
   SP_SEC_SOURCE,
+  SP_SEC_LAYOUT,
+  SP_SEC_SHAPE,
   SP_SEC_CELLS, /**< a sequence of cell mappings, not a mapping of scalars */
   SP_N_SECTIONS
 } sp_section;
 
 static const char *const sp_section_names[SP_N_SECTIONS] = {
     "mesh", "model", "time", "noise", "solver", "output", "division", "source",
-    "cells"};
+    "layout", "shape", "cells"};
 
 /** Scalar type of a key as the user sees it. */
 typedef enum {
@@ -130,6 +132,8 @@ static const cyaml_strval_t sp_division_words[] = {
     {"none", SP_DIVIDE_NONE}, {"age", SP_DIVIDE_BY_AGE}, {"mass", SP_DIVIDE_BY_MASS}};
 static const cyaml_strval_t sp_cut_words[] = {
     {"sharp", SP_CUT_SHARP}, {"smooth", SP_CUT_SMOOTH}};
+static const cyaml_strval_t sp_support_words[] = {
+    {"auto", SP_SUPPORT_AUTO}, {"full", SP_SUPPORT_FULL}, {"local", SP_SUPPORT_LOCAL}};
 /* The YAML 1.1 booleans; the first word of each value is the one printed. */
 static const cyaml_strval_t sp_bool_words[] = {
     {"true", 1}, {"false", 0}, {"yes", 1}, {"no", 0}, {"on", 1}, {"off", 0}};
@@ -316,6 +320,34 @@ static const sp_key sp_keys[] = {
     KEY_FLOAT(SP_SEC_SOURCE, "off_ratio", source.off_ratio, 1.1, ABOVE(1.0),
               UNBOUNDED, "-",
               "a cell's source stops once N >= N_max and m_k / m_k^0 > this"),
+    /* layout */
+    KEY_ENUM(SP_SEC_LAYOUT, "support", layout.support, SP_SUPPORT_AUTO,
+             sp_support_words, "-",
+             "each field on the whole mesh (full: the paper) or on a moving "
+             "neighbourhood of its cell (local); auto: local when the scene "
+             "can hold more than 4 cells"),
+    KEY_FLOAT(SP_SEC_LAYOUT, "margin", layout.margin, 8.0, ABOVE(0.0),
+              UNBOUNDED, "d",
+              "local: the support reaches this many interface widths d "
+              "beyond the cell's core"),
+    KEY_FLOAT(SP_SEC_LAYOUT, "core_threshold", layout.core_threshold, 0.1,
+              ABOVE(0.0), BELOW(1.0), "-", "local: the core is c_k >= this"),
+    KEY_FLOAT(SP_SEC_LAYOUT, "grow_threshold", layout.grow_threshold, 0.1,
+              ABOVE(0.0), BELOW(1.0), "-",
+              "local: supports are recomputed when c_k >= this within band "
+              "of a support's edge"),
+    KEY_FLOAT(SP_SEC_LAYOUT, "band", layout.band, 4.0, ABOVE(0.0), UNBOUNDED,
+              "d", "local: width of that band in interface widths (< margin)"),
+    /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
+     * in E L^2, so delta is in E / L^6 */
+    KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),
+              UNBOUNDED, "E/L^6",
+              "shape penalty modulus on the larger principal moment I^1 "
+              "(0: none; the paper's single-cell study: -> 0)"),
+    KEY_FLOAT(SP_SEC_SHAPE, "delta2", shape.delta2, 0.0, AT_LEAST(0.0),
+              UNBOUNDED, "E/L^6",
+              "shape penalty modulus on the smaller principal moment I^2 "
+              "(0: none; the paper: 5e4 to 2e5)"),
     /* cells: one mapping per initial cell */
     CELL_FLOAT_REQUIRED("x", x, UNBOUNDED, UNBOUNDED, "L",
                         "centre x; the cell's disk must lie inside Omega"),
@@ -993,6 +1025,10 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
            "%s: time.dt_min: expected a number <= time.dt = %.15g, got "
            "%.15g",
            file, t->dt, t->dt_min);
+  SP_CHECK(scene->layout.band < scene->layout.margin, SP_ERR_INPUT,
+           "%s: layout.band: expected a number < layout.margin = %.15g, got "
+           "%.15g",
+           file, scene->layout.margin, scene->layout.band);
   if (scene->mesh.type == SP_MESH_RECTANGLE) {
     const sp_scene_mesh *m = &scene->mesh;
     SP_CHECK(m->x1 > m->x0, SP_ERR_INPUT,

@@ -114,6 +114,23 @@ typedef struct {
   double off_ratio; /**< switch off once N >= N_max and m/m0 > this */
 } sp_scene_source;
 
+typedef enum { SP_SUPPORT_AUTO = 0, SP_SUPPORT_FULL = 1, SP_SUPPORT_LOCAL = 2 } sp_support_kind;
+
+/** layout: where each cell's field lives. */
+typedef struct {
+  sp_support_kind support; /**< auto | full (the paper) | local */
+  double margin;           /**< local: support = core + this many widths d */
+  double core_threshold;   /**< local: the core is c_k >= this */
+  double grow_threshold;   /**< local: grow when c_k >= this ... */
+  double band;             /**< ... within this many widths of the edge */
+} sp_scene_layout;
+
+/** shape: the shape penalty on principal moments (MODEL.md, paper sec. 3). */
+typedef struct {
+  double delta1; /**< modulus on the larger principal moment I^1 */
+  double delta2; /**< modulus on the smaller principal moment I^2 */
+} sp_scene_shape;
+
 typedef struct sp_scene {
   sp_scene_mesh mesh;
   sp_scene_model model;
@@ -123,6 +140,8 @@ typedef struct sp_scene {
   sp_scene_output output;
   sp_scene_division division;
   sp_scene_source source;
+  sp_scene_shape shape;
+  sp_scene_layout layout;
   int n_cells;
   sp_scene_cell *cells;
 } sp_scene;

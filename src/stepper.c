@@ -12,7 +12,9 @@
 #include "layout.h"
 #include "output.h"
 #include "render.h"
+#include "shape.h"
 #include "source.h"
+#include "support.h"
 
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
   const sp_scene_mesh *m = &scene->mesh;
@@ -41,6 +43,18 @@ void sp_model_from_scene(const sp_scene *scene, sp_model_params *model) {
   model->mobility = scene->model.mobility;
 }
 
+int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *layout) {
+  sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
+  sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
+                       layout->pair_cell};
+  if (sp_solver_set_problem(solver, &mv, &lv) != 0)
+    return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(solver));
+  return SP_OK;
+}
+
+/** layout.support: auto turns local supports on beyond this many cells. */
+#define SP_AUTO_LOCAL_CELLS 4
+
 static double wall_clock(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -68,6 +82,8 @@ typedef struct {
   int *division_skipped; /* due but no field left: reported once */
   double *source;        /* per pair, from c^n */
   int n_max;             /* N_max */
+  sp_support support;    /* local supports (NULL: full) */
+  sp_run_summary *sum;
   sp_division_params division;
 } sp_run;
 
@@ -84,7 +100,11 @@ static int record_energy(sp_run *run, int step, double t, double dt, int its) {
   sp_energy_parts parts;
   if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
     return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
-  const double total = parts.bulk + parts.gradient + parts.repulsion + parts.buffer;
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
+                           run->scene->division.observe_threshold, run->obs));
+  const double shape = sp_shape_energy(run->layout->n_cells, run->obs, run->birth,
+                                       run->scene->shape.delta1, run->scene->shape.delta2);
+  const double total = parts.bulk + parts.gradient + parts.repulsion + parts.buffer + shape;
   if (run->n_energy == run->cap_energy) {
     int cap = run->cap_energy ? 2 * run->cap_energy : 1024;
     double *t_new = realloc(run->energy_t, cap * sizeof(double));
@@ -97,10 +117,8 @@ static int record_energy(sp_run *run, int step, double t, double dt, int its) {
   }
   run->energy_t[run->n_energy] = t;
   run->energy_total[run->n_energy++] = total;
-  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
-                           run->scene->division.observe_threshold, run->obs));
   if (run->rank != 0) return SP_OK;
-  SP_CALL(sp_output_energy(run->output, step, t, dt, its, run->layout->n_cells, &parts, 0.0));
+  SP_CALL(sp_output_energy(run->output, step, t, dt, its, run->layout->n_cells, &parts, shape));
   SP_CALL(sp_output_cells(run->output, step, t, run->layout->n_cells, run->obs));
   return SP_OK;
 }
@@ -128,15 +146,49 @@ static int grow_array(void **ptr, size_t elem, int n_old, int n) {
   return SP_OK;
 }
 
-/** Tell the solver about the current layout (rebuilds maps and graph). */
-static int solver_set_layout(sp_run *run) {
-  sp_mesh_view mv = {run->mesh->n_nodes, run->mesh->n_elems, run->mesh->xy,
-                     run->mesh->elem, run->mesh->region};
-  sp_layout_view lv = {run->layout->n_nodes, run->layout->n_cells, run->layout->n_pairs,
-                       run->layout->node_start, run->layout->pair_cell};
-  if (sp_solver_set_problem(run->solver, &mv, &lv) != 0)
-    return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(run->solver));
+/** Make (layout, state) the run's own, resize the per-pair buffers and
+ *  hand the layout to the solver. */
+static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
+  sp_layout_destroy(&run->layout);
+  free(run->state);
+  free(run->state_old);
+  free(run->source);
+  run->layout = layout;
+  run->state = state;
+  SP_ALLOC(run->state_old, 2 * (size_t)layout->n_pairs);
+  SP_ALLOC(run->source, layout->n_pairs);
+  return sp_solver_attach(run->solver, run->mesh, run->layout);
+}
+
+/** Local supports: recompute every support from the fields (they follow
+ *  the cells), keeping each cell's mass exactly. */
+static int update_supports(sp_run *run) {
+  const double t0 = wall_clock();
+  sp_layout *layout;
+  double *state, correction;
+  SP_CALL(sp_support_rebuild(run->support, run->layout, run->state, &layout, &state, &correction));
+  SP_CALL(adopt_layout(run, layout, state));
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
+                           run->scene->division.observe_threshold, run->obs));
+  run->sum->layout_changes += 1;
+  if (correction > run->sum->support_mass_correction) run->sum->support_mass_correction = correction;
+  run->sum->t_layout += wall_clock() - t0;
   return SP_OK;
+}
+
+/** The layout after a division: full, or every support as it is plus the
+ *  child on the parent's support (the next update tightens both). */
+static int layout_with_child(sp_run *run, int parent, sp_layout **out) {
+  const int n = run->layout->n_cells, nn = run->mesh->n_nodes;
+  if (!run->support) return sp_layout_create_full(nn, n + 1, out);
+  unsigned char *mask;
+  SP_ALLOC(mask, (size_t)nn * (n + 1));
+  for (int k = 0; k <= n; ++k)
+    for (int i = 0; i < nn; ++i)
+      mask[(size_t)k * nn + i] = sp_layout_pair(run->layout, k < n ? k : parent, i) >= 0;
+  int rc = sp_layout_create_from_masks(nn, n + 1, mask, out);
+  free(mask);
+  return rc;
 }
 
 /**
@@ -147,7 +199,7 @@ static int solver_set_layout(sp_run *run) {
 static int divide_cell(sp_run *run, int parent, double t, int step) {
   const int n = run->layout->n_cells, child = n;
   sp_layout *new_layout = NULL;
-  SP_CALL(sp_layout_create_full(run->mesh->n_nodes, n + 1, &new_layout));
+  SP_CALL(layout_with_child(run, parent, &new_layout));
   const size_t n_values = 2 * (size_t)new_layout->n_pairs;
   double *new_state = calloc(n_values, sizeof(double));
   double *new_old = calloc(n_values, sizeof(double));
@@ -184,7 +236,7 @@ static int divide_cell(sp_run *run, int parent, double t, int step) {
   core_view(run->obs, n + 1, core);
   sp_division_record_births(t, core, parent, child, run->birth);
   free(core);
-  SP_CALL(solver_set_layout(run));
+  SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   double px, py, dx, dy;
   sp_division_axis(&parent_obs, &px, &py, &dx, &dy);
   double angle = atan2(dy, dx);
@@ -235,10 +287,14 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   SP_CALL(record_energy(run, 0, t, 0.0, 0));
   SP_CALL(write_snapshot(run, 0, t));
   const double t_tol = 1e-12 * tc->t_end;
+  /* the shape penalty's per-cell coefficients, refreshed before each step */
+  const int shape_on = run->scene->shape.delta1 > 0 || run->scene->shape.delta2 > 0;
+  sp_shape_coef *shape_coef = NULL;
   int rc = SP_OK;
   while (rc == SP_OK && t < tc->t_end - t_tol && step < tc->max_steps) {
     const int n_cells = run->layout->n_cells;
     const size_t n_values = 2 * (size_t)run->layout->n_pairs;
+    if ((long)n_values > sum->unknowns_max) sum->unknowns_max = (long)n_values;
     double dt_try = fmin(dt, tc->t_end - t);
     if (since_division >= 0) /* paper algorithm 2 after a division */
       dt_try = fmin(dt_try, sp_division_dt(tc->dt, dv->n_div, dv->m, since_division + 1));
@@ -248,9 +304,21 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                           run->scene->source.rate, run->source);
       if (rc != SP_OK) break;
     }
+    if (shape_on) { /* explicit: from the observables of c^n (run->obs) */
+      sp_shape_coef *grown_coef = realloc(shape_coef, sizeof *shape_coef * (size_t)n_cells);
+      if (!grown_coef) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
+      shape_coef = grown_coef;
+      rc = sp_shape_coefficients(n_cells, run->obs, run->birth, run->scene->shape.delta1,
+                                 run->scene->shape.delta2, shape_coef);
+      if (rc != SP_OK) break;
+      /* the term is the derivative of the moments, which count c only
+       * where c >= the observables' threshold: it acts there only */
+      for (int k = 0; k < n_cells; ++k)
+        shape_coef[k].threshold = run->scene->division.observe_threshold;
+    }
     sp_step_data data = {.dt = dt_try, .model = run->model, .state_old = run->state_old,
                          .source = run->scene->source.rate > 0 ? run->source : NULL,
-                         .shape = NULL};
+                         .shape = shape_on ? shape_coef : NULL};
     sp_step_report report;
     int solved = sp_solver_step(run->solver, &data, run->state, &report);
     sum->t_assembly += report.t_assembly;
@@ -301,6 +369,10 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     int n_divided = 0;
     if (rc == SP_OK) rc = divide_due_cells(run, t_old, t, step, core_mass_old, &n_divided);
     if (rc != SP_OK) break;
+    if (rc == SP_OK && run->support &&
+        (n_divided || sp_support_needs_update(run->support, run->layout, run->state)))
+      rc = update_supports(run);
+    if (rc != SP_OK) break;
     if (n_divided) {
       since_division = 0;
       sum->divisions += n_divided;
@@ -321,6 +393,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     if (step % run->scene->output.every == 0 || last || n_divided) rc = write_snapshot(run, step, t);
   }
   sum->n_cells = run->layout->n_cells;
+  free(shape_coef);
   free(core_mass_old);
   return rc;
 }
@@ -340,6 +413,7 @@ static void run_free(sp_run *run) {
   free(run->source_on);
   free(run->division_skipped);
   free(run->source);
+  sp_support_destroy(&run->support);
 }
 
 static int run_setup(sp_run *run, MPI_Comm comm) {
@@ -352,12 +426,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   sp_model_from_scene(scene, &run->model);
   if (sp_solver_create(comm, &opt, &run->solver) != 0)
     return sp_error_set(SP_ERR_INPUT, "solver: %s", sp_solver_last_error(run->solver));
-  sp_mesh_view mv = {run->mesh->n_nodes, run->mesh->n_elems, run->mesh->xy,
-                     run->mesh->elem, run->mesh->region};
-  sp_layout_view lv = {run->layout->n_nodes, run->layout->n_cells, run->layout->n_pairs,
-                       run->layout->node_start, run->layout->pair_cell};
-  if (sp_solver_set_problem(run->solver, &mv, &lv) != 0)
-    return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(run->solver));
+  SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
   const int n = scene->n_cells;
   SP_ALLOC(run->state, n_values);
@@ -383,6 +452,34 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   run->n_max = dv->max_cells > 0 ? dv->max_cells
                : sp_division_max_cells(sp_mesh_region_area(run->mesh, SP_REGION_OMEGA),
                                        run->birth[0].birth_mass);
+  const sp_scene_layout *ly = &scene->layout;
+  const int can_divide = dv->criterion != SP_DIVIDE_NONE;
+  const int local = ly->support == SP_SUPPORT_LOCAL ||
+                    (ly->support == SP_SUPPORT_AUTO &&
+                     (n > SP_AUTO_LOCAL_CELLS || (can_divide && run->n_max > SP_AUTO_LOCAL_CELLS)));
+  if (local) {
+    /* The initial fields are cut to the initial supports: background and
+     * noise exist only there (docs/local-support.md). */
+    const double d = sp_scene_interface_width(scene);
+    sp_support_params sp = {.margin = ly->margin * d, .core_threshold = ly->core_threshold,
+                            .grow_threshold = ly->grow_threshold, .band = ly->band * d};
+    SP_CALL(sp_support_create(run->mesh, &sp, &run->support));
+    unsigned char *mask;
+    SP_ALLOC(mask, (size_t)run->mesh->n_nodes * n);
+    sp_layout *layout = NULL;
+    int rc = sp_support_masks(run->support, run->layout, run->state, mask);
+    if (rc == SP_OK) rc = sp_support_layout_from_masks(run->support, n, mask, &layout);
+    free(mask);
+    SP_CALL(rc);
+    double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
+    if (!state) {
+      sp_layout_destroy(&layout);
+      return sp_error_set(SP_ERR_MEMORY, "out of memory for the local layout");
+    }
+    sp_layout_transfer(run->layout, run->state, layout, state, 0.0);
+    SP_CALL(adopt_layout(run, layout, state));
+    SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold, run->obs));
+  }
   run->division = (sp_division_params){
       .criterion = dv->criterion == SP_DIVIDE_BY_AGE ? SP_DIVIDE_AGE : SP_DIVIDE_MASS,
       .age = dv->t_div, .mass_ratio = dv->mass_ratio,
@@ -393,8 +490,8 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
 
 int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
                    sp_run_summary *summary) {
-  sp_run run = {.scene = scene};
   sp_run_summary sum = {0};
+  sp_run run = {.scene = scene, .sum = &sum};
   const double t0 = wall_clock();
   int rc = run_setup(&run, comm);
   /* Only now, with the input known good, does anything get written. */

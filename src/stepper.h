@@ -10,6 +10,7 @@
 
 #include <mpi.h>
 
+#include "layout.h"
 #include "mesh.h"
 #include "scene.h"
 #include "softpack_solver.h"
@@ -29,6 +30,11 @@ typedef struct {
   double t_assembly, t_factor, t_solve; /**< seconds over the run */
   int divisions;       /**< cell divisions */
   int n_cells;         /**< cells at the end */
+  int layout_changes;  /**< local supports: times the supports were rebuilt */
+  double support_mass_correction; /**< largest relative mass change a
+                                       support change caused (restored) */
+  double t_layout;     /**< seconds spent rebuilding supports */
+  long unknowns_max;   /**< largest number of unknowns of a step */
 } sp_run_summary;
 
 /** @brief The mesh a scene describes. */
@@ -36,6 +42,10 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out);
 /** @brief Solver options and model parameters from a scene. */
 void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt);
 void sp_model_from_scene(const sp_scene *scene, sp_model_params *model);
+
+/** @brief Hand the solver a mesh and layout (maps and graph are rebuilt
+ *         when the layout changed). */
+int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *layout);
 
 /**
  * @brief Run a scene into @p out_dir. Everything that can be checked before

@@ -13,6 +13,7 @@
 #include "mesh.h"
 #include "q1.h"
 #include "softpack_solver.h"
+#include "stepper.h"
 
 /** The paper's parameters (table 1). */
 static inline sp_model_params paper_model(void) {
@@ -28,11 +29,8 @@ static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout
     fprintf(stderr, "sp_solver_create: %s\n", sp_solver_last_error(s));
     exit(1);
   }
-  sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
-  sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
-                       layout->pair_cell};
-  if (sp_solver_set_problem(s, &mv, &lv) != 0) {
-    fprintf(stderr, "sp_solver_set_problem: %s\n", sp_solver_last_error(s));
+  if (sp_solver_attach(s, mesh, layout) != SP_OK) {
+    fprintf(stderr, "%s\n", sp_error_message());
     exit(1);
   }
   return s;

@@ -1,0 +1,177 @@
+#include "checkjac.h"
+
+#include <math.h>
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cells.h"
+#include "error.h"
+#include "layout.h"
+#include "mesh.h"
+#include "scene.h"
+#include "softpack_solver.h"
+#include "stepper.h"
+
+/** What the command holds. */
+typedef struct {
+  sp_scene *scene;
+  sp_mesh *mesh;
+  sp_layout *layout;
+  sp_solver solver;
+  sp_model_params model;
+  double *state, *state_old;
+  int rank;
+} checkjac;
+
+static void checkjac_free(checkjac *c) {
+  sp_solver_destroy(&c->solver);
+  sp_layout_destroy(&c->layout);
+  sp_mesh_destroy(&c->mesh);
+  sp_scene_destroy(&c->scene);
+  free(c->state);
+  free(c->state_old);
+}
+
+/** Mesh, full layout, solver and initial state, as the stepper builds them. */
+static int checkjac_setup(checkjac *c) {
+  const sp_scene *scene = c->scene;
+  MPI_Comm_rank(MPI_COMM_WORLD, &c->rank);
+  SP_CALL(sp_mesh_from_scene(scene, &c->mesh));
+  SP_CALL(sp_layout_create_full(c->mesh->n_nodes, scene->n_cells, &c->layout));
+  sp_solver_options opt;
+  sp_solver_options_from_scene(scene, &opt);
+  sp_model_from_scene(scene, &c->model);
+  if (sp_solver_create(MPI_COMM_WORLD, &opt, &c->solver) != 0)
+    return sp_error_set(SP_ERR_INPUT, "solver: %s", sp_solver_last_error(c->solver));
+  sp_mesh_view mv = {c->mesh->n_nodes, c->mesh->n_elems, c->mesh->xy, c->mesh->elem,
+                     c->mesh->region};
+  sp_layout_view lv = {c->layout->n_nodes, c->layout->n_cells, c->layout->n_pairs,
+                       c->layout->node_start, c->layout->pair_cell};
+  if (sp_solver_set_problem(c->solver, &mv, &lv) != 0)
+    return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(c->solver));
+  const size_t n_values = 2 * (size_t)c->layout->n_pairs;
+  SP_ALLOC(c->state, n_values);
+  SP_ALLOC(c->state_old, n_values);
+  return sp_cells_initial_state(scene, c->mesh, c->layout, c->state);
+}
+
+static int compare(checkjac *c, const sp_step_data *data, int a, int b, double *out) {
+  if (sp_solver_compare_jacobians(c->solver, data, c->state, a, b, out) != 0)
+    return sp_error_set(SP_ERR_INTERNAL, "comparing Jacobians: %s",
+                        sp_solver_last_error(c->solver));
+  return SP_OK;
+}
+
+/** The table for the current state; *worst_hand_ad gets the largest
+ *  hand-vs-ad figure over its rows. */
+static int check_state(checkjac *c, const char *what, double t, double *worst_hand_ad) {
+  /* At the start of a step: state_old = state, Jacobian at the state. */
+  memcpy(c->state_old, c->state, 2 * (size_t)c->layout->n_pairs * sizeof(double));
+  static const char *rows[] = {"all terms", "lambda = 0", "lambda_b = 0",
+                               "lambda = lambda_b = 0"};
+  if (c->rank == 0)
+    printf("\n%s (t = %.6g):\n  %-24s %12s %12s %12s\n", what, t, "terms", "hand vs ad",
+           "ad vs fd", "hand vs fd");
+  for (int r = 0; r < 4; ++r) {
+    sp_step_data data = {.dt = c->scene->time.dt, .model = c->model,
+                         .state_old = c->state_old, .source = NULL, .shape = NULL};
+    if (r == 1 || r == 3) data.model.lambda = 0.0;
+    if (r == 2 || r == 3) data.model.lambda_b = 0.0;
+    double hand_ad, ad_fd, hand_fd;
+    SP_CALL(compare(c, &data, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD, &hand_ad));
+    SP_CALL(compare(c, &data, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD, &ad_fd));
+    SP_CALL(compare(c, &data, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD, &hand_fd));
+    if (c->rank == 0)
+      printf("  %-24s %12.3e %12.3e %12.3e\n", rows[r], hand_ad, ad_fd, hand_fd);
+    if (!(hand_ad <= *worst_hand_ad)) *worst_hand_ad = hand_ad; /* NaN sticks */
+  }
+  return SP_OK;
+}
+
+/** K backward-Euler steps at the scene's dt, shrinking dt by time.shrink
+ *  after a failed Newton solve (never accepting it), as the stepper does. */
+static int take_steps(checkjac *c, int steps, double *t, double *dt_last, int *retries) {
+  const sp_scene_time *tc = &c->scene->time;
+  const size_t n_values = 2 * (size_t)c->layout->n_pairs;
+  double dt = tc->dt;
+  int failures = 0;
+  for (int step = 0; step < steps;) {
+    memcpy(c->state_old, c->state, n_values * sizeof(double));
+    sp_step_data data = {.dt = dt, .model = c->model, .state_old = c->state_old,
+                         .source = NULL, .shape = NULL};
+    sp_step_report report;
+    int rc = sp_solver_step(c->solver, &data, c->state, &report);
+    if (rc > 1)
+      return sp_error_set(SP_ERR_SOLVER, "step %d: %s", step + 1,
+                          sp_solver_last_error(c->solver));
+    if (rc == 1) {
+      memcpy(c->state, c->state_old, n_values * sizeof(double));
+      ++*retries;
+      dt *= tc->shrink;
+      if (++failures > tc->max_retries || dt < tc->dt_min)
+        return sp_error_set(SP_ERR_SOLVER, "Newton failed on step %d at t = %.6g: %s",
+                            step + 1, *t, report.reason);
+      continue;
+    }
+    failures = 0;
+    *dt_last = dt;
+    *t += dt;
+    ++step;
+  }
+  return SP_OK;
+}
+
+int sp_check_jacobian_command(int argc, char **argv) {
+  const char *scene_path = NULL;
+  const char **sets = calloc(argc > 0 ? argc : 1, sizeof(char *));
+  SP_CHECK(sets, SP_ERR_MEMORY, "out of memory");
+  int n_set = 0, steps = 1, rc = SP_OK;
+  for (int i = 0; i < argc && rc == SP_OK; ++i) {
+    if (strcmp(argv[i], "--set") == 0 && i + 1 < argc) {
+      sets[n_set++] = argv[++i];
+    } else if (strcmp(argv[i], "--steps") == 0 && i + 1 < argc) {
+      char *end;
+      long k = strtol(argv[++i], &end, 10);
+      if (*argv[i] == '\0' || *end != '\0' || k < 0 || k > 1000000)
+        rc = sp_error_set(SP_ERR_INPUT, "--steps: expected an integer >= 0, got '%s'", argv[i]);
+      steps = (int)k;
+    } else if (argv[i][0] == '-') {
+      rc = sp_error_set(SP_ERR_INPUT, "unknown option or missing value: %s", argv[i]);
+    } else if (!scene_path) {
+      scene_path = argv[i];
+    } else {
+      rc = sp_error_set(SP_ERR_INPUT, "more than one scene file: %s and %s", scene_path, argv[i]);
+    }
+  }
+  if (rc == SP_OK && !scene_path)
+    rc = sp_error_set(SP_ERR_INPUT, "softpack check-jacobian needs a scene file");
+  checkjac c = {0};
+  if (rc == SP_OK) rc = sp_scene_load(scene_path, n_set, sets, &c.scene);
+  free(sets);
+  if (rc == SP_OK) rc = checkjac_setup(&c);
+  double t = 0.0, worst = 0.0;
+  if (rc == SP_OK && c.rank == 0)
+    printf("softpack check-jacobian %s: %d nodes, %d elements, %d cells; "
+           "max over elements of max|J_a - J_b| / max|J_b|\n",
+           scene_path, c.mesh->n_nodes, c.mesh->n_elems, c.scene->n_cells);
+  if (rc == SP_OK) rc = check_state(&c, "initial state", t, &worst);
+  if (rc == SP_OK && steps > 0) {
+    double dt_last = 0.0;
+    int retries = 0;
+    rc = take_steps(&c, steps, &t, &dt_last, &retries);
+    char what[160];
+    snprintf(what, sizeof what, "after %d step%s (last dt %.3g, %d failed attempt%s retried)",
+             steps, steps == 1 ? "" : "s", dt_last, retries, retries == 1 ? "" : "s");
+    if (rc == SP_OK) rc = check_state(&c, what, t, &worst);
+  }
+  if (rc == SP_OK && c.rank == 0)
+    printf("\nhand vs ad: largest relative difference %.3e (tolerance %.0e): %s\n", worst,
+           SP_CHECKJAC_TOLERANCE, worst <= SP_CHECKJAC_TOLERANCE ? "ok" : "DIFFERENT");
+  if (rc == SP_OK && !(worst <= SP_CHECKJAC_TOLERANCE))
+    rc = sp_error_set(SP_ERR_SOLVER, "the hand and ad Jacobians differ by %.3e relative "
+                      "(> %.0e)", worst, SP_CHECKJAC_TOLERANCE);
+  checkjac_free(&c);
+  return rc;
+}

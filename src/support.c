@@ -1,0 +1,267 @@
+#include "support.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cells.h"
+#include "error.h"
+#include "q1.h"
+
+struct sp_support_s {
+  const sp_mesh *mesh;
+  sp_support_params params;
+  int *ne_start, *ne_list; /* elements around each node (CSR) */
+  double *elem_area;
+  /* scratch, n_nodes each */
+  int *source, *queue;
+  double *best;
+  unsigned char *in_set;
+};
+
+int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_support *out) {
+  SP_CHECK(params->margin > 0 && params->band > 0 && params->band < params->margin,
+           SP_ERR_INPUT, "layout: need 0 < band (%g) < margin (%g)", params->band,
+           params->margin);
+  struct sp_support_s *s;
+  SP_ALLOC(s, 1);
+  *out = s;
+  s->mesh = mesh;
+  s->params = *params;
+  const int nn = mesh->n_nodes, ne = mesh->n_elems;
+  SP_ALLOC(s->ne_start, nn + 1);
+  SP_ALLOC(s->ne_list, 4 * (size_t)ne);
+  SP_ALLOC(s->elem_area, ne);
+  SP_ALLOC(s->source, nn);
+  SP_ALLOC(s->queue, nn);
+  SP_ALLOC(s->best, nn);
+  SP_ALLOC(s->in_set, nn);
+  for (int e = 0; e < ne; ++e)
+    for (int a = 0; a < 4; ++a) ++s->ne_start[mesh->elem[4 * e + a] + 1];
+  for (int i = 0; i < nn; ++i) s->ne_start[i + 1] += s->ne_start[i];
+  int *fill;
+  SP_ALLOC(fill, nn);
+  for (int e = 0; e < ne; ++e) {
+    for (int a = 0; a < 4; ++a) {
+      int n = mesh->elem[4 * e + a];
+      s->ne_list[s->ne_start[n] + fill[n]++] = e;
+    }
+    double xy[4][2], N[4], dN[4][2], x[2], w;
+    sp_mesh_elem_xy(mesh, e, xy);
+    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+      sp_q1_point(xy, q, N, dN, x, &w);
+      s->elem_area[e] += w;
+    }
+  }
+  free(fill);
+  return SP_OK;
+}
+
+void sp_support_destroy(sp_support *s) {
+  if (!s || !*s) return;
+  free((*s)->ne_start);
+  free((*s)->ne_list);
+  free((*s)->elem_area);
+  free((*s)->source);
+  free((*s)->queue);
+  free((*s)->best);
+  free((*s)->in_set);
+  free(*s);
+  *s = NULL;
+}
+
+static double node_distance(const sp_mesh *m, int i, int j) {
+  return hypot(m->xy[2 * i] - m->xy[2 * j], m->xy[2 * i + 1] - m->xy[2 * j + 1]);
+}
+
+/**
+ * Multi-source search from the n_seeds nodes in s->queue[0..n_seeds):
+ * every node reachable through element neighbours whose straight distance
+ * to the nearest seed found along the way is <= radius, restricted to
+ * allowed nodes (NULL: all), is marked in s->in_set with s->best its
+ * distance. Returns the number of nodes reached; their list is s->queue.
+ */
+static int grow_from_seeds(sp_support s, int n_seeds, double radius,
+                           const unsigned char *allowed) {
+  const sp_mesh *m = s->mesh;
+  int head = 0, tail = n_seeds;
+  for (int q = 0; q < n_seeds; ++q) {
+    int i = s->queue[q];
+    s->in_set[i] = 1;
+    s->best[i] = 0;
+    s->source[i] = i;
+  }
+  while (head < tail) {
+    const int i = s->queue[head++];
+    for (int t = s->ne_start[i]; t < s->ne_start[i + 1]; ++t) {
+      const int *nodes = m->elem + 4 * s->ne_list[t];
+      for (int a = 0; a < 4; ++a) {
+        const int j = nodes[a];
+        if (allowed && !allowed[j]) continue;
+        const double d = node_distance(m, j, s->source[i]);
+        if (d > radius || (s->in_set[j] && d >= s->best[j])) continue;
+        if (!s->in_set[j]) s->queue[tail++] = j;
+        s->in_set[j] = 1;
+        s->best[j] = d;
+        s->source[j] = s->source[i];
+      }
+    }
+  }
+  return tail;
+}
+
+static void clear_set(sp_support s, int n) {
+  for (int q = 0; q < n; ++q) s->in_set[s->queue[q]] = 0;
+}
+
+int sp_support_masks(sp_support s, const sp_layout *layout, const double *state,
+                     unsigned char *mask) {
+  const int nn = s->mesh->n_nodes;
+  memset(mask, 0, (size_t)nn * layout->n_cells);
+  for (int k = 0; k < layout->n_cells; ++k) {
+    unsigned char *mk = mask + (size_t)k * nn;
+    int n_seeds = 0;
+    for (int i = 0; i < nn; ++i) {
+      int p = sp_layout_pair(layout, k, i);
+      if (p >= 0 && state[2 * p] >= s->params.core_threshold) s->queue[n_seeds++] = i;
+    }
+    if (n_seeds == 0) { /* no core: keep the support it has */
+      for (int i = 0; i < nn; ++i) mk[i] = sp_layout_pair(layout, k, i) >= 0;
+      continue;
+    }
+    int reached = grow_from_seeds(s, n_seeds, s->params.margin, NULL);
+    for (int q = 0; q < reached; ++q) mk[s->queue[q]] = 1;
+    clear_set(s, reached);
+  }
+  return SP_OK;
+}
+
+int sp_support_layout_from_masks(sp_support s, int n_cells, unsigned char *mask,
+                                 sp_layout **out) {
+  /* Keep only nodes of whole elements of each cell (the solver's rule). */
+  const sp_mesh *m = s->mesh;
+  const int nn = m->n_nodes;
+  unsigned char *kept;
+  SP_ALLOC(kept, nn);
+  for (int k = 0; k < n_cells; ++k) {
+    unsigned char *mk = mask + (size_t)k * nn;
+    memset(kept, 0, nn);
+    for (int e = 0; e < m->n_elems; ++e) {
+      const int *nodes = m->elem + 4 * e;
+      if (mk[nodes[0]] && mk[nodes[1]] && mk[nodes[2]] && mk[nodes[3]])
+        for (int a = 0; a < 4; ++a) kept[nodes[a]] = 1;
+    }
+    memcpy(mk, kept, nn);
+  }
+  free(kept);
+  return sp_layout_create_from_masks(nn, n_cells, mask, out);
+}
+
+/** Node i of cell k's support is on its edge: an element around it is not
+ *  whole for cell k. */
+static int on_edge(sp_support s, const sp_layout *layout, int k, int i) {
+  for (int t = s->ne_start[i]; t < s->ne_start[i + 1]; ++t) {
+    const int *nodes = s->mesh->elem + 4 * s->ne_list[t];
+    for (int a = 0; a < 4; ++a)
+      if (sp_layout_pair(layout, k, nodes[a]) < 0) return 1;
+  }
+  return 0;
+}
+
+int sp_support_needs_update(sp_support s, const sp_layout *layout, const double *state) {
+  const int nn = s->mesh->n_nodes;
+  unsigned char *allowed = calloc(nn, 1);
+  if (!allowed) return 1; /* rebuilding is always safe */
+  int grow = 0;
+  for (int k = 0; k < layout->n_cells && !grow; ++k) {
+    int n_seeds = 0;
+    for (int i = 0; i < nn; ++i) {
+      allowed[i] = sp_layout_pair(layout, k, i) >= 0;
+      if (allowed[i] && on_edge(s, layout, k, i)) s->queue[n_seeds++] = i;
+    }
+    int reached = grow_from_seeds(s, n_seeds, s->params.band, allowed);
+    for (int q = 0; q < reached && !grow; ++q) {
+      int p = sp_layout_pair(layout, k, s->queue[q]);
+      grow = state[2 * p] >= s->params.grow_threshold;
+    }
+    clear_set(s, reached);
+  }
+  free(allowed);
+  return grow;
+}
+
+/** Area of the whole elements of cell k. */
+static double support_area(sp_support s, const sp_layout *layout, int k) {
+  double area = 0;
+  for (int e = 0; e < s->mesh->n_elems; ++e) {
+    const int *nodes = s->mesh->elem + 4 * e;
+    int whole = 1;
+    for (int a = 0; a < 4 && whole; ++a) whole = sp_layout_pair(layout, k, nodes[a]) >= 0;
+    if (whole) area += s->elem_area[e];
+  }
+  return area;
+}
+
+int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *state,
+                       sp_layout **new_layout, double **new_state, double *mass_correction) {
+  const int nn = s->mesh->n_nodes, nc = layout->n_cells;
+  *new_layout = NULL;
+  *new_state = NULL;
+  *mass_correction = 0;
+  unsigned char *mask;
+  SP_ALLOC(mask, (size_t)nn * (nc ? nc : 1));
+  int rc = sp_support_masks(s, layout, state, mask);
+  if (rc == SP_OK) rc = sp_support_layout_from_masks(s, nc, mask, new_layout);
+  free(mask);
+  SP_CALL(rc);
+  sp_layout *to = *new_layout;
+  double *next;
+  SP_ALLOC(next, 2 * (size_t)to->n_pairs);
+  *new_state = next;
+  sp_layout_transfer(layout, state, to, next, 0.0);
+  sp_cell_obs *before, *after;
+  SP_ALLOC(before, nc);
+  SP_ALLOC(after, nc);
+  for (int k = 0; k < nc; ++k) {
+    /* New nodes get the mean far field of the old edge. */
+    double edge_c = 0, edge_mu = 0;
+    int n_edge = 0;
+    for (int i = 0; i < nn; ++i) {
+      int p = sp_layout_pair(layout, k, i);
+      if (p >= 0 && on_edge(s, layout, k, i)) {
+        edge_c += state[2 * p];
+        edge_mu += state[2 * p + 1];
+        ++n_edge;
+      }
+    }
+    if (n_edge) {
+      edge_c /= n_edge;
+      edge_mu /= n_edge;
+    }
+    for (int i = 0; i < nn; ++i) {
+      int q = sp_layout_pair(to, k, i);
+      if (q >= 0 && sp_layout_pair(layout, k, i) < 0) {
+        next[2 * q] = edge_c;
+        next[2 * q + 1] = edge_mu;
+      }
+    }
+  }
+  rc = sp_cells_observe(s->mesh, layout, state, 0.0, before);
+  if (rc == SP_OK) rc = sp_cells_observe(s->mesh, to, next, 0.0, after);
+  for (int k = 0; k < nc && rc == SP_OK; ++k) {
+    /* A uniform shift over the support restores the mass exactly (the
+     * shape functions of a whole-element domain sum to one). */
+    const double change = after[k].mass - before[k].mass;
+    const double rel = before[k].mass != 0 ? fabs(change / before[k].mass) : fabs(change);
+    if (rel > *mass_correction) *mass_correction = rel;
+    const double area = support_area(s, to, k);
+    const double shift = area > 0 ? -change / area : 0.0;
+    for (int i = 0; i < nn; ++i) {
+      int q = sp_layout_pair(to, k, i);
+      if (q >= 0) next[2 * q] += shift;
+    }
+  }
+  free(before);
+  free(after);
+  return rc;
+}

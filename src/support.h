@@ -1,0 +1,73 @@
+/**
+ * @file support.h
+ * @brief Local supports (beyond the paper; MODEL.md "Beyond the paper"):
+ *        each cell's field lives on the whole elements within a margin of
+ *        its core (c_k >= core threshold), and the support follows the cell.
+ *
+ * A field's domain is a union of whole elements (the solver's rule), with a
+ * natural no-flux boundary, so mass is conserved exactly between support
+ * changes. When a cell's c_k exceeds the grow threshold within a band at
+ * its support's edge, every support is recomputed from the current fields
+ * (which may also shrink it); values move with (cell, node), new nodes get
+ * the mean far-field value of the old edge, and each cell's mass is then
+ * restored exactly by a uniform shift of c_k over its new support. The mass
+ * changes that shift corrects are reported.
+ */
+#ifndef SP_SUPPORT_H
+#define SP_SUPPORT_H
+
+#include "layout.h"
+#include "mesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sp_support_s *sp_support;
+
+/** Parameters (lengths in the model's length unit). */
+typedef struct {
+  double margin;         /**< support = elements within this of the core */
+  double core_threshold; /**< the core: nodes with c_k >= this */
+  double grow_threshold; /**< grow when c_k >= this ... */
+  double band;           /**< ... within this distance of the support edge */
+} sp_support_params;
+
+/** @brief Node adjacency of a mesh and the parameters. */
+int sp_support_create(const sp_mesh *mesh, const sp_support_params *params,
+                      sp_support *out);
+
+/**
+ * @brief Support masks of every cell from its field: mask[k * n_nodes + i]
+ *        is 1 when node i is in cell k's support. A cell with an empty core
+ *        keeps its current support (so it cannot vanish).
+ */
+int sp_support_masks(sp_support s, const sp_layout *layout,
+                     const double *state, unsigned char *mask);
+
+/** @brief 1 if some cell's c_k >= grow_threshold within the band of its
+ *         support's edge (the domain boundary is not an edge), else 0. */
+int sp_support_needs_update(sp_support s, const sp_layout *layout,
+                            const double *state);
+
+/**
+ * @brief New supports from the fields, values moved to them, masses
+ *        restored. @p new_layout and @p new_state are allocated here.
+ * @param[out] mass_correction largest |mass change before correction| /
+ *             mass over the cells (what the uniform shift restored)
+ */
+int sp_support_rebuild(sp_support s, const sp_layout *layout,
+                       const double *state, sp_layout **new_layout,
+                       double **new_state, double *mass_correction);
+
+/** @brief Layout from per-cell masks, with every cell's mask closed to
+ *         whole elements (no node without a whole element of its cell). */
+int sp_support_layout_from_masks(sp_support s, int n_cells,
+                                 unsigned char *mask, sp_layout **out);
+
+void sp_support_destroy(sp_support *s);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
