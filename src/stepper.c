@@ -96,12 +96,12 @@ static void core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
   }
 }
 
+/** Energy and observables rows of the current state (run->obs must be the
+ *  observables of run->state: every change of the state refreshes them). */
 static int record_energy(sp_run *run, int step, double t, double dt, int its) {
   sp_energy_parts parts;
   if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
     return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
-  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
-                           run->scene->division.observe_threshold, run->obs));
   const double shape = sp_shape_energy(run->layout->n_cells, run->obs, run->birth,
                                        run->scene->shape.delta1, run->scene->shape.delta2);
   const double total = parts.bulk + parts.gradient + parts.repulsion + parts.buffer + shape;

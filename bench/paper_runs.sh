@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Reruns the paper's runs 1, 2 and 5 (issue 3) and prints, per run, the
+# table of docs/paper-runs.md; copies the pictures at each stage (the last
+# picture with N cells, for every N reached) and the energy curve to
+# docs/img/paper/<run>/.
+#   bench/paper_runs.sh [--reuse] [run ...]   runs: constant_volume_16 growth_12 embryo_8
+# --reuse: do not rerun a run whose out/paper/<run>/ and out/paper/<run>.log
+# exist (tables and pictures from that earlier run).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+reuse=0
+[ "${1:-}" = "--reuse" ] && { reuse=1; shift; }
+runs=("$@")
+[ ${#runs[@]} -eq 0 ] && runs=(constant_volume_16 growth_12 embryo_8)
+export OMP_NUM_THREADS=1
+for run in "${runs[@]}"; do
+  out=out/paper/$run
+  if [ $reuse -eq 0 ] || [ ! -f "$out.log" ] || [ ! -f "$out/energy.csv" ]; then
+    rm -rf "$out"
+    mkdir -p out/paper
+    build/softpack run "inputs/paper/$run.yaml" --out "$out" > "$out.log" 2>&1
+  fi
+  echo "== $run (inputs/paper/$run.yaml)"
+  grep '^softpack:' "$out.log" | grep -v 'is due to divide' | sed 's/^/   /'
+  # final cells, steps, Newton iterations
+  awk -F, 'NR > 1 { n = $5; steps = $1; its += $4 } END {
+      printf "   final cells %d, steps %d, Newton iterations %d\n", n, steps, its }' "$out/energy.csv"
+  # total cell mass drift and each cell against the mean at the end
+  awk -F, 'NR == 1 { next } { m[$1] += $4; last = $1 } $1 == 0 { m0 += $4 }
+    { cell[$1, $3] = $4; ncell[$1] = ($3 > ncell[$1] ? $3 : ncell[$1]) }
+    END { mean = m[last] / ncell[last]; worst = 0
+      for (k = 1; k <= ncell[last]; ++k) { d = cell[last, k] / mean - 1; if (d < 0) d = -d; if (d > worst) worst = d }
+      drift = (m[last] - m0) / m0; if (drift < 0) drift = -drift
+      printf "   total cell mass %.10g -> %.10g (relative change %.2e); largest deviation of a cell from the mean mass %.1f%%\n",
+             m0, m[last], drift, 100 * worst }' "$out/cells.csv"
+  # growth runs: the step after which the total cell mass stays constant
+  # (every source off) and whether the energy then decreases monotonically
+  if grep -q '^source:.*rate: *[1-9]' "inputs/paper/$run.yaml"; then
+    off=$(awk -F, 'NR > 1 { m[$1] += $4; last = $1 } END {
+        s = last; while (s > 0 && (s - 1) in m && (m[s - 1] - m[last])^2 <= (1e-12 * m[last])^2) --s; print s }' "$out/cells.csv")
+    awk -F, -v off="$off" 'NR > 1 && $1 >= off { if (seen && $6 > prev) { ++rises; if ($6 - prev > worst) worst = $6 - prev }
+        prev = $6; seen = 1; ++n }
+      END { printf "   sources off from step %d on (total mass constant after it); energy over the %d steps since: %s\n",
+            off, n, rises ? sprintf("rises %d times (largest %.3g)", rises, worst) : "decreases monotonically" }' "$out/energy.csv"
+  fi
+  echo "   divisions (t, step, parent, child, axis angle):"
+  awk -F, 'NR > 1 { printf "     %.5f  %4d  %2d -> %2d  %+.3f\n", $1, $2, $3, $4, $5 }' "$out/divisions.csv"
+  # pictures at each stage
+  img=docs/img/paper/$run
+  rm -rf "$img" && mkdir -p "$img"
+  cp "$out/energy.png" "$img/energy.png"
+  awk -F, 'NR > 1 { print $1, $5 }' "$out/energy.csv" > "$out/cells_per_step.txt"
+  for png in "$out"/cells_*.png; do
+    step=$(basename "$png" .png | sed 's/cells_0*//'); step=${step:-0}
+    n=$(awk -v s="$step" '$1 == s { print $2 }' "$out/cells_per_step.txt")
+    cp "$png" "$img/cells_$(printf %02d "$n").png"   # later pictures overwrite: the last with n cells
+  done
+  echo "   pictures: $(ls "$img" | tr '\n' ' ')"
+done

@@ -1,0 +1,82 @@
+/* Hard cases of division (issue 3):
+ * - eight cells dividing in the same step: 8 -> 16 cells, eight rows of
+ *   divisions.csv with the same step, each split conserving its parent's
+ *   mass, total mass conserved; one cell is pressed against the buffer ring;
+ * - a division whose first step fails Newton: without algorithm 2
+ *   (n_div = 0, m = 0) the first step after a sharp cut is taken at the
+ *   full dt and needs 5 Newton iterations where a steady step needs 2;
+ *   with solver.newton_max_its = 4 it fails, is retried with a smaller dt
+ *   and the run goes on (never accepting the failed step). */
+#include <string.h>
+
+#include "check.h"
+#include "error.h"
+#include "scene.h"
+#include "stepper.h"
+
+static int count_rows(const char *path, int *same_step) {
+  FILE *f = fopen(path, "r");
+  char line[1024];
+  int rows = 0, first_step = -1;
+  *same_step = 1;
+  if (!f) return -1;
+  if (!fgets(line, sizeof line, f)) { fclose(f); return -1; }
+  while (fgets(line, sizeof line, f)) {
+    double t, angle, before, after_p, after_c;
+    int step, parent, child;
+    if (sscanf(line, "%lf,%d,%d,%d,%lf,%lf,%lf,%lf", &t, &step, &parent, &child, &angle, &before,
+               &after_p, &after_c) != 8)
+      continue;
+    if (first_step < 0) first_step = step;
+    if (step != first_step) *same_step = 0;
+    CHECK(fabs(after_p + after_c - before) <= 1e-12 * before, "split of cell %d: %.17g + %.17g != %.17g",
+          parent, after_p, after_c, before);
+    ++rows;
+  }
+  fclose(f);
+  return rows;
+}
+
+static double total_mass(const char *path, int want_step) {
+  FILE *f = fopen(path, "r");
+  char line[1024];
+  double total = 0;
+  if (!f) return NAN;
+  if (!fgets(line, sizeof line, f)) { fclose(f); return NAN; }
+  while (fgets(line, sizeof line, f)) {
+    int step, cell;
+    double t, m;
+    if (sscanf(line, "%d,%lf,%d,%lf", &step, &t, &cell, &m) == 4 && step == want_step) total += m;
+  }
+  fclose(f);
+  return total;
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  sp_scene *scene;
+  sp_run_summary sum;
+  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_eight.yaml", 0, NULL, &scene));
+  CHECK_OK(sp_stepper_run(scene, "hard_eight", MPI_COMM_WORLD, &sum));
+  int same_step;
+  int rows = count_rows("hard_eight/divisions.csv", &same_step);
+  double m0 = total_mass("hard_eight/cells.csv", 0), m1 = total_mass("hard_eight/cells.csv", sum.steps);
+  printf("eight at once: %d cells, %d divisions (same step: %s), total mass %.15g -> %.15g\n",
+         sum.n_cells, rows, same_step ? "yes" : "no", m0, m1);
+  CHECK(sum.n_cells == 16 && rows == 8 && same_step, "%d cells, %d divisions", sum.n_cells, rows);
+  CHECK(fabs(m1 - m0) <= 1e-10 * m0, "total mass %.17g -> %.17g", m0, m1);
+  sp_scene_destroy(&scene);
+
+  const char *set[] = {"division.n_div=0", "division.m=0", "solver.newton_max_its=4"};
+  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 3, set, &scene));
+  scene->time.t_end = 0.0046; /* the first division and a few steps */
+  CHECK_OK(sp_stepper_run(scene, "hard_retry", MPI_COMM_WORLD, &sum));
+  printf("no algorithm 2: %d cells, %d failed attempts retried, smallest dt %.3g\n", sum.n_cells,
+         sum.failed_attempts, sum.dt_smallest);
+  CHECK(sum.n_cells == 2, "%d cells", sum.n_cells);
+  CHECK(sum.failed_attempts >= 1, "Newton never failed after the sharp cut at the full dt");
+  CHECK(sum.dt_smallest < scene->time.dt, "smallest dt %g", sum.dt_smallest);
+  sp_scene_destroy(&scene);
+  MPI_Finalize();
+  TEST_DONE();
+}
