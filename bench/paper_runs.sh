@@ -27,12 +27,15 @@ for run in "${runs[@]}"; do
       printf "   final cells %d, steps %d, Newton iterations %d\n", n, steps, its }' "$out/energy.csv"
   # total cell mass drift and each cell against the mean at the end
   awk -F, 'NR == 1 { next } { m[$1] += $4; last = $1 } $1 == 0 { m0 += $4 }
-    { cell[$1, $3] = $4; ncell[$1] = ($3 > ncell[$1] ? $3 : ncell[$1]) }
-    END { mean = m[last] / ncell[last]; worst = 0
-      for (k = 1; k <= ncell[last]; ++k) { d = cell[last, k] / mean - 1; if (d < 0) d = -d; if (d > worst) worst = d }
+    { cell[$1, $3] = $4; core[$1, $3] = $10; ncell[$1] = ($3 > ncell[$1] ? $3 : ncell[$1]) }
+    END { n = ncell[last]; mean = m[last] / n; worst = 0; core_mean = 0
+      for (k = 1; k <= n; ++k) { d = cell[last, k] / mean - 1; if (d < 0) d = -d; if (d > worst) worst = d; core_mean += core[last, k] / n }
       drift = (m[last] - m0) / m0; if (drift < 0) drift = -drift
       printf "   total cell mass %.10g -> %.10g (relative change %.2e); largest deviation of a cell from the mean mass %.1f%%\n",
-             m0, m[last], drift, 100 * worst }' "$out/cells.csv"
+             m0, m[last], drift, 100 * worst
+      if (core_mean > 0) { worst = 0
+        for (k = 1; k <= n; ++k) { d = core[last, k] / core_mean - 1; if (d < 0) d = -d; if (d > worst) worst = d }
+        printf "   largest deviation of a cell'"'"'s core mass (c >= 0.05) from the mean %.1f%%\n", 100 * worst } }' "$out/cells.csv"
   # growth runs: the step after which the total cell mass stays constant
   # (every source off) and whether the energy then decreases monotonically
   if grep -q '^source:.*rate: *[1-9]' "inputs/paper/$run.yaml"; then

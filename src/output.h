@@ -28,7 +28,8 @@ int sp_output_energy(sp_output out, int step, double t, double dt,
                      double shape);
 
 /** @brief Append one row per cell to cells.csv:
- *  step,t,cell,mass,xc,yc,I1,I2,angle (cells numbered from 1) */
+ *  step,t,cell,mass,xc,yc,I1,I2,angle,core_mass (cells numbered from 1;
+ *  core_mass counts c only where c >= the observables' threshold) */
 int sp_output_cells(sp_output out, int step, double t, int n_cells,
                     const sp_cell_obs *obs);
 
