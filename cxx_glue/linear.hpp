@@ -1,29 +1,61 @@
 // Direct linear solvers behind one small interface on plain CSR arrays, so
-// the backends never see Epetra (and a later move to Tpetra is cheap).
+// the Newton code never depends on a backend and the backends never see the
+// Jacobian's Epetra objects (a later move to Tpetra is cheap). The Amesos
+// backends build their own Epetra matrix from the arrays (linear_amesos.cpp).
 #ifndef SP_LINEAR_HPP
 #define SP_LINEAR_HPP
+
+#include <mpi.h>
 
 #include <memory>
 #include <string>
 
 namespace sp {
 
+// This rank's rows of a square n_global x n_global matrix distributed by
+// contiguous row blocks in rank order: rank r holds rows first_row ..
+// first_row + n_rows - 1, and the blocks of ranks 0, 1, ... follow each
+// other (what SuperLU_DIST's SLU_NR_loc format wants). One rank: first_row
+// = 0, n_rows = n_global. Column indices are global and 0-based; the arrays
+// are borrowed for the call only (every backend copies what it keeps).
+struct CsrRows {
+  int n_global = 0;
+  int first_row = 0;
+  int n_rows = 0;
+  const int *row_ptr = nullptr;  // n_rows + 1 offsets into col/val
+  const int *col = nullptr;      // global column indices
+  const double *val = nullptr;
+};
+
+// Every call is collective over the solver's communicator.
 class DirectSolver {
  public:
   virtual ~DirectSolver() = default;
-  // Factor the n x n matrix in CSR form (0-based). same_pattern: the
-  // sparsity pattern equals the previous call's, so the symbolic work
-  // (column ordering) can be reused. Returns false on a singular matrix.
-  virtual bool factor(int n, const int *row_ptr, const int *col, const double *val,
-                      bool same_pattern, std::string &why) = 0;
-  // Solve A x = b with the last factorisation.
+  // Factor A. same_pattern: the sparsity pattern (and row distribution)
+  // equals the previous call's, so the symbolic work (ordering, symbolic
+  // factorisation) can be reused. Returns false on a singular matrix or
+  // another failure, with why set (possibly on some ranks only: the caller
+  // makes the ranks agree).
+  virtual bool factor(const CsrRows &A, bool same_pattern, std::string &why) = 0;
+  // Solve A x = b with the last factorisation; b and x are this rank's
+  // n_rows entries.
   virtual bool solve(const double *b, double *x, std::string &why) = 0;
   // Number of symbolic analyses done (for tests of the reuse).
   virtual int symbolic_count() const = 0;
 };
 
-// Serial SuperLU (dgstrf/dgstrs on the transposed CSC view of the CSR).
+// Serial SuperLU (dgstrf/dgstrs on the transposed CSC view of the CSR); one
+// rank holding all rows.
 std::unique_ptr<DirectSolver> make_superlu();
+// A serial solver run on rank 0 of comm: factor() gathers the rows there,
+// solve() gathers b and scatters x. serial is used on rank 0 only (may be
+// null elsewhere).
+std::unique_ptr<DirectSolver> make_gathered(MPI_Comm comm, std::unique_ptr<DirectSolver> serial);
+// SuperLU_DIST (pdgssvx, SLU_NR_loc rows as they are distributed).
+std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm);
+// Amesos (v1) on an Epetra copy of the rows: which = "Amesos_Mumps" or
+// "Amesos_Klu". Throws if Amesos was built without it.
+std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &which);
 
 }  // namespace sp
 #endif

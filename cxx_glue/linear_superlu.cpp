@@ -35,9 +35,15 @@ class SuperLU final : public DirectSolver {
     StatFree(&stat_);
   }
 
-  bool factor(int n, const int *row_ptr, const int *col, const double *val,
-              bool same_pattern, std::string &why) override {
+  bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
     release_factors();
+    if (A.first_row != 0 || A.n_rows != A.n_global) {
+      why = "SuperLU: the serial solver needs all rows on one process";
+      return false;
+    }
+    const int n = A.n_global;
+    const int *row_ptr = A.row_ptr, *col = A.col;
+    const double *val = A.val;
     const int nnz = row_ptr[n];
     // SuperLU keeps pointers into A: own copies of the arrays.
     ptr_.assign(row_ptr, row_ptr + n + 1);

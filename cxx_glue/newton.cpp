@@ -14,6 +14,7 @@
 #include <NOX_StatusTest_MaxIters.H>
 #include <NOX_StatusTest_NormF.H>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -142,28 +143,71 @@ class AtLeastOneIteration : public NOX::StatusTest::Generic {
 
 Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     : comm_(comm), options_(options) {
-  if (options.linear != SP_SOLVER_SUPERLU)
-    throw std::runtime_error("solver.linear: only superlu is built so far");
-  if (comm_.NumProc() > 1)
-    throw std::runtime_error("solver.linear superlu runs on one process; MPI runs are not built yet");
   if (options.jacobian < SP_SOLVER_JAC_AD || options.jacobian > SP_SOLVER_JAC_FD)
     throw std::runtime_error("solver.jacobian: unknown kind");
-  direct_ = make_superlu();
+  const int P = comm_.NumProc();
+  switch (options.linear) {
+    case SP_SOLVER_SUPERLU:
+      // Serial SuperLU under MPI: the matrix is gathered on rank 0.
+      direct_ = P == 1 ? make_superlu()
+                       : make_gathered(comm, comm_.MyPID() == 0 ? make_superlu() : nullptr);
+      break;
+    case SP_SOLVER_SUPERLU_DIST: direct_ = make_superlu_dist(comm); break;
+    case SP_SOLVER_MUMPS: direct_ = make_amesos(comm, "Amesos_Mumps"); break;
+    case SP_SOLVER_KLU2:
+      // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
+      // ranks (docs/parallel.md): KLU runs on one process only.
+      if (P > 1)
+        throw std::runtime_error("solver.linear: klu2 runs on one MPI process only (this run has " +
+                                 std::to_string(P) +
+                                 "); use superlu_dist or mumps with several processes");
+      direct_ = make_amesos(comm, "Amesos_Klu");
+      break;
+    default: throw std::runtime_error("solver.linear: unknown kind");
+  }
 }
 
 void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout) {
   if (assembly_ && assembly_->same_layout(layout)) return;
   assembly_.reset(new Assembly(comm_, mesh, layout));
   jacobian_matrix = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
-  // The CSR pattern handed to the direct solver (one rank: local = global).
+  // The CSR rows handed to the direct solver: this rank's rows, global
+  // column indices. The backends need each rank's rows contiguous and the
+  // blocks in rank order (the node partition of Assembly gives that).
   const Epetra_CrsGraph &g = assembly_->graph();
   const int n = g.NumMyRows();
+  first_row_ = n > 0 ? g.RowMap().GID(0) : 0;
+  for (int i = 0; i < n; ++i)
+    if (g.RowMap().GID(i) != first_row_ + i)
+      throw std::logic_error("the rows of a rank are not contiguous");
+  const int P = comm_.NumProc();
+  std::vector<int> firsts(P), counts(P);
+  MPI_Allgather(&first_row_, 1, MPI_INT, firsts.data(), 1, MPI_INT, comm_.Comm());
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_.Comm());
+  for (int r = 0, next = 0; r < P; next += counts[r], ++r)
+    if (counts[r] > 0 && firsts[r] != next)
+      throw std::logic_error("the row blocks of the ranks are not in rank order");
+  first_row_ = 0;  // (also right for a rank without rows)
+  for (int r = 0; r < comm_.MyPID(); ++r) first_row_ += counts[r];
+  n_global_ = g.NumGlobalRows();
+  // Columns sorted by global index within each row: the same arrays for
+  // any number of ranks (Epetra orders a row by local column index, which
+  // depends on the partition, and orderings break ties by entry order).
+  // csr_from_[k]: the position in the Epetra row of sorted entry k.
   csr_ptr_.assign(1, 0);
   csr_col_.clear();
+  csr_from_.clear();
+  std::vector<std::pair<int, int>> row;
   for (int i = 0; i < n; ++i) {
     int len, *idx;
     g.ExtractMyRowView(i, len, idx);
-    for (int k = 0; k < len; ++k) csr_col_.push_back(g.RowMap().LID(g.ColMap().GID(idx[k])));
+    row.resize(len);
+    for (int k = 0; k < len; ++k) row[k] = {g.ColMap().GID(idx[k]), k};
+    std::sort(row.begin(), row.end());
+    for (const auto &e : row) {
+      csr_col_.push_back(e.first);
+      csr_from_.push_back(e.second);
+    }
     csr_ptr_.push_back((int)csr_col_.size());
   }
   csr_val_.assign(csr_col_.size(), 0.0);
@@ -202,25 +246,59 @@ void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
   t_assembly += now() - t0;
 }
 
+namespace {
+
+// Every rank learns whether all ranks succeeded and, if not, the message of
+// the lowest failing rank (NOX must take the same path on every rank).
+bool agree(MPI_Comm comm, bool ok, std::string &why) {
+  int rank, size;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  int mine = ok ? size : rank, first = size;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == size) return true;
+  int len = rank == first ? (int)why.size() : 0;
+  MPI_Bcast(&len, 1, MPI_INT, first, comm);
+  std::string msg(len, ' ');
+  if (rank == first) msg = why;
+  MPI_Bcast(&msg[0], len, MPI_CHAR, first, comm);
+  why = msg.empty() ? "the linear solver failed" : msg;
+  if (size > 1 && first > 0) why += " (rank " + std::to_string(first) + ")";
+  return false;
+}
+
+}  // namespace
+
 bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
   if (jacobian_fresh_) {
     double t0 = now();
     const int n = (int)csr_ptr_.size() - 1;
-    for (int i = 0, pos = 0; i < n; ++i) {
+    for (int i = 0; i < n; ++i) {
       int len;
       double *vals;
       jacobian_matrix->ExtractMyRowView(i, len, vals);
-      for (int k = 0; k < len; ++k) csr_val_[pos++] = vals[k];
+      for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = vals[csr_from_[k]];
     }
-    bool ok = direct_->factor(n, csr_ptr_.data(), csr_col_.data(), csr_val_.data(),
-                              !pattern_changed_, why);
+    CsrRows A;
+    A.n_global = n_global_;
+    A.first_row = first_row_;
+    A.n_rows = n;
+    A.row_ptr = csr_ptr_.data();
+    A.col = csr_col_.data();
+    A.val = csr_val_.data();
+    bool ok = direct_->factor(A, !pattern_changed_, why);
+    ok = agree(comm_.Comm(), ok, why);
     t_factor += now() - t0;
-    if (!ok) return false;
+    if (!ok) {
+      pattern_changed_ = true;  // start the next factorisation from scratch
+      return false;
+    }
     pattern_changed_ = false;
     jacobian_fresh_ = false;
   }
   double t0 = now();
   bool ok = direct_->solve(b.Values(), x.Values(), why);
+  ok = agree(comm_.Comm(), ok, why);
   t_solve += now() - t0;
   return ok;
 }

@@ -53,7 +53,9 @@ class Solver {
   sp_solver_options options_;
   std::unique_ptr<Assembly> assembly_;
   std::unique_ptr<DirectSolver> direct_;
-  std::vector<int> csr_ptr_, csr_col_;  // pattern of the matrix, row-wise
+  std::vector<int> csr_ptr_, csr_col_;  // this rank's rows: pattern, global columns (sorted)
+  std::vector<int> csr_from_;           // position of each entry in its Epetra row
+  int first_row_ = 0, n_global_ = 0;    // the rows are first_row_ .. + n_rows - 1
   std::vector<double> csr_val_;
   bool jacobian_fresh_ = false;  // the matrix changed since the last factor
   bool pattern_changed_ = true;  // the layout changed since the last factor

@@ -98,11 +98,13 @@ int main(int argc, char **argv) {
                       argc >= 2 ? ": " : "", argc >= 2 ? argv[1] : "");
   }
   const int status = sp_error_exit_status(rc);
-  if (rc != SP_OK && rank == 0) fprintf(stderr, "softpack: error: %s\n", sp_error_message());
   if (rc != SP_OK) {
-    /* One rank's failure ends all ranks, never a hang. */
+    /* One rank's failure ends all ranks, never a hang. Every failing rank
+     * prints its message: an error seen by rank > 0 alone is not lost. */
     int size = 1;
     MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (rank == 0) fprintf(stderr, "softpack: error: %s\n", sp_error_message());
+    else fprintf(stderr, "softpack: error (rank %d of %d): %s\n", rank, size, sp_error_message());
     if (size > 1) MPI_Abort(MPI_COMM_WORLD, status);
   }
   MPI_Finalize();

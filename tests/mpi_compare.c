@@ -1,0 +1,350 @@
+/* MPI runs against one-process runs (ctest label mpi; tests/CMakeLists.txt
+ * runs it under mpirun with np = 1, 2, 3). Not a test_*.c: it needs mpirun.
+ *
+ *   mpi_compare steps LABEL SCENE [section.key=value]...
+ *     Rank 0 runs the scene alone (MPI_COMM_SELF) into mpi_LABEL_ref, then
+ *     every rank runs it together (MPI_COMM_WORLD) into mpi_LABEL_np<P>;
+ *     rank 0 compares the CSVs: same steps, times and cell counts, the same
+ *     divisions (step, parent, child), energies equal to 1e-9 relative (each
+ *     part to 1e-9 of the total), cell masses to 1e-10 relative.
+ *
+ *   mpi_compare iterates LINEAR...
+ *     The first Newton iterates of one step (three touching cells, 40 x 40
+ *     rectangle) with each backend LINEAR (superlu, superlu_dist, mumps,
+ *     klu2) on MPI_COMM_WORLD against serial SuperLU on MPI_COMM_SELF:
+ *     max |x_k - x_k,ref| <= 1e-10 max |x_k,ref| for k = 1..4.
+ *
+ *   mpi_compare cli            (run without mpirun)
+ *     The real program under `mpirun -np 2`: a bad scene, klu2 (refused on
+ *     several processes) and an unwritable output directory each end within
+ *     60 s (timeout -s KILL) with the right status and the message.
+ */
+#include <errno.h>
+#include <mpi.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+
+#include "fixtures.h"
+#include "scene.h"
+
+/* ---------- CSV files ---------- */
+
+typedef struct {
+  int n_rows, n_cols;
+  char header[1024];
+  double *v; /* n_rows x n_cols */
+} csv_table;
+
+static int csv_read(const char *path, csv_table *t) {
+  memset(t, 0, sizeof *t);
+  FILE *f = fopen(path, "r");
+  if (!f) return -1;
+  char line[4096];
+  int cap = 0;
+  if (!fgets(t->header, sizeof t->header, f)) {
+    fclose(f);
+    return -1;
+  }
+  t->n_cols = 1;
+  for (const char *c = t->header; *c; ++c) t->n_cols += *c == ',';
+  while (fgets(line, sizeof line, f)) {
+    if (t->n_rows == cap) {
+      cap = cap ? 2 * cap : 256;
+      t->v = realloc(t->v, (size_t)cap * t->n_cols * sizeof(double));
+    }
+    char *s = line;
+    for (int j = 0; j < t->n_cols; ++j) {
+      t->v[(size_t)t->n_rows * t->n_cols + j] = strtod(s, &s);
+      if (*s == ',') ++s;
+    }
+    ++t->n_rows;
+  }
+  fclose(f);
+  return 0;
+}
+
+static int csv_col(const csv_table *t, const char *name) {
+  char h[1024];
+  snprintf(h, sizeof h, "%s", t->header);
+  h[strcspn(h, "\r\n")] = '\0';
+  int j = 0;
+  for (char *tok = strtok(h, ","); tok; tok = strtok(NULL, ","), ++j)
+    if (strcmp(tok, name) == 0) return j;
+  CHECK(0, "no column %s", name);
+  return 0;
+}
+
+static double at(const csv_table *t, int i, const char *name) {
+  return t->v[(size_t)i * t->n_cols + csv_col(t, name)];
+}
+
+static double rel(double a, double b) {
+  double s = fmax(fabs(a), fabs(b));
+  return s > 0 ? fabs(a - b) / s : 0.0;
+}
+
+/* ---------- steps: a scene on P ranks against one ---------- */
+
+static void compare_runs(const char *ref, const char *par) {
+  char path[2048];
+  csv_table er, ep, cr, cp, dr, dp;
+  snprintf(path, sizeof path, "%s/energy.csv", ref);
+  CHECK(csv_read(path, &er) == 0, "cannot read %s", path);
+  snprintf(path, sizeof path, "%s/energy.csv", par);
+  CHECK(csv_read(path, &ep) == 0, "cannot read %s", path);
+  snprintf(path, sizeof path, "%s/cells.csv", ref);
+  CHECK(csv_read(path, &cr) == 0, "cannot read %s", path);
+  snprintf(path, sizeof path, "%s/cells.csv", par);
+  CHECK(csv_read(path, &cp) == 0, "cannot read %s", path);
+  snprintf(path, sizeof path, "%s/divisions.csv", ref);
+  CHECK(csv_read(path, &dr) == 0, "cannot read %s", path);
+  snprintf(path, sizeof path, "%s/divisions.csv", par);
+  CHECK(csv_read(path, &dp) == 0, "cannot read %s", path);
+  if (sp_test_failures) return;
+
+  CHECK(er.n_rows == ep.n_rows, "energy rows %d vs %d", er.n_rows, ep.n_rows);
+  static const char *parts[] = {"bulk", "gradient", "repulsion", "buffer", "shape"};
+  double worst_e = 0, worst_part = 0, worst_t = 0;
+  int its_differ = 0;
+  for (int i = 0; i < er.n_rows && i < ep.n_rows; ++i) {
+    CHECK(at(&er, i, "step") == at(&ep, i, "step"), "row %d: step %g vs %g", i,
+          at(&er, i, "step"), at(&ep, i, "step"));
+    CHECK(at(&er, i, "n_cells") == at(&ep, i, "n_cells"), "step %g: %g vs %g cells",
+          at(&er, i, "step"), at(&er, i, "n_cells"), at(&ep, i, "n_cells"));
+    worst_t = fmax(worst_t, fmax(rel(at(&er, i, "t"), at(&ep, i, "t")),
+                                 rel(at(&er, i, "dt"), at(&ep, i, "dt"))));
+    const double e = at(&er, i, "energy");
+    worst_e = fmax(worst_e, rel(e, at(&ep, i, "energy")));
+    for (int k = 0; k < 5; ++k)
+      worst_part = fmax(worst_part, fabs(at(&er, i, parts[k]) - at(&ep, i, parts[k])) / fabs(e));
+    its_differ += at(&er, i, "newton_its") != at(&ep, i, "newton_its");
+  }
+  printf("energy.csv: %d steps; largest relative difference: t/dt %.2e, energy %.2e, "
+         "parts (of the energy) %.2e; Newton iteration counts differ on %d steps\n",
+         er.n_rows, worst_t, worst_e, worst_part, its_differ);
+  CHECK(worst_t <= 1e-12, "t or dt differ by %.3g", worst_t);
+  CHECK(worst_e <= 1e-9, "energies differ by %.3g relative", worst_e);
+  CHECK(worst_part <= 1e-9, "energy parts differ by %.3g of the energy", worst_part);
+
+  CHECK(cr.n_rows == cp.n_rows, "cells rows %d vs %d", cr.n_rows, cp.n_rows);
+  double worst_m = 0, worst_x = 0;
+  for (int i = 0; i < cr.n_rows && i < cp.n_rows; ++i) {
+    CHECK(at(&cr, i, "step") == at(&cp, i, "step") && at(&cr, i, "cell") == at(&cp, i, "cell"),
+          "cells row %d: (step, cell) differ", i);
+    worst_m = fmax(worst_m, rel(at(&cr, i, "mass"), at(&cp, i, "mass")));
+    worst_x = fmax(worst_x, fmax(fabs(at(&cr, i, "xc") - at(&cp, i, "xc")),
+                                 fabs(at(&cr, i, "yc") - at(&cp, i, "yc"))));
+  }
+  printf("cells.csv: %d rows; largest relative mass difference %.2e, centre difference %.2e\n",
+         cr.n_rows, worst_m, worst_x);
+  CHECK(worst_m <= 1e-10, "cell masses differ by %.3g relative", worst_m);
+  CHECK(worst_x <= 1e-8, "cell centres differ by %.3g", worst_x);
+
+  CHECK(dr.n_rows == dp.n_rows, "divisions %d vs %d", dr.n_rows, dp.n_rows);
+  double worst_dm = 0;
+  for (int i = 0; i < dr.n_rows && i < dp.n_rows; ++i) {
+    CHECK(at(&dr, i, "step") == at(&dp, i, "step") && at(&dr, i, "parent") == at(&dp, i, "parent") &&
+              at(&dr, i, "child") == at(&dp, i, "child"),
+          "division %d: step/parent/child %g/%g/%g vs %g/%g/%g", i, at(&dr, i, "step"),
+          at(&dr, i, "parent"), at(&dr, i, "child"), at(&dp, i, "step"), at(&dp, i, "parent"),
+          at(&dp, i, "child"));
+    worst_dm = fmax(worst_dm, fmax(rel(at(&dr, i, "parent_mass_after"), at(&dp, i, "parent_mass_after")),
+                                   rel(at(&dr, i, "child_mass_after"), at(&dp, i, "child_mass_after"))));
+  }
+  printf("divisions.csv: %d divisions at steps", dr.n_rows);
+  for (int i = 0; i < dr.n_rows; ++i) printf(" %g", at(&dr, i, "step"));
+  printf("; largest relative mass difference %.2e\n", worst_dm);
+  CHECK(dr.n_rows >= 1, "the scene should divide");
+  CHECK(worst_dm <= 1e-10, "division masses differ by %.3g relative", worst_dm);
+  free(er.v); free(ep.v); free(cr.v); free(cp.v); free(dr.v); free(dp.v);
+}
+
+static int cmd_steps(int argc, char **argv, int rank, int size) {
+  if (argc < 2) {
+    fprintf(stderr, "usage: mpi_compare steps LABEL SCENE [key=value]...\n");
+    return 2;
+  }
+  const char *label = argv[0], *scene_path = argv[1];
+  sp_scene *scene = NULL;
+  CHECK_OK(sp_scene_load(scene_path, argc - 2, (const char *const *)argv + 2, &scene));
+  char ref[512], par[512], cmd[1200];
+  snprintf(ref, sizeof ref, "mpi_%s_ref", label);
+  snprintf(par, sizeof par, "mpi_%s_np%d", label, size);
+  sp_run_summary sum_ref = {0}, sum_par = {0};
+  if (rank == 0) {
+    snprintf(cmd, sizeof cmd, "rm -rf %s %s", ref, par);
+    CHECK(system(cmd) == 0, "%s", cmd);
+    double t0 = MPI_Wtime();
+    CHECK_OK(sp_stepper_run(scene, ref, MPI_COMM_SELF, &sum_ref));
+    printf("one process: %d steps, %.1f s\n", sum_ref.steps, MPI_Wtime() - t0);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  double t0 = MPI_Wtime();
+  CHECK_OK(sp_stepper_run(scene, par, MPI_COMM_WORLD, &sum_par));
+  if (rank == 0) {
+    printf("%d processes: %d steps, %.1f s\n", size, sum_par.steps, MPI_Wtime() - t0);
+    CHECK(sum_ref.steps == sum_par.steps, "%d vs %d steps", sum_ref.steps, sum_par.steps);
+    compare_runs(ref, par);
+  }
+  sp_scene_destroy(&scene);
+  return 0;
+}
+
+/* ---------- iterates: one step's Newton iterates per backend ---------- */
+
+static int linear_kind(const char *name) {
+  if (strcmp(name, "superlu") == 0) return SP_SOLVER_SUPERLU;
+  if (strcmp(name, "superlu_dist") == 0) return SP_SOLVER_SUPERLU_DIST;
+  if (strcmp(name, "mumps") == 0) return SP_SOLVER_MUMPS;
+  if (strcmp(name, "klu2") == 0) return SP_SOLVER_KLU2;
+  return -1;
+}
+
+enum { N_ITERATES = 4 };
+
+/* x_1..x_4 of the step from `old` with `guess` as x_0: each call does
+ * exactly one Newton update (atol huge: converged after one update). */
+static void newton_iterates(MPI_Comm comm, int linear, const sp_mesh *mesh, const sp_layout *layout,
+                            const double *old, const double *guess, double *iterates,
+                            double *seconds) {
+  const int n = 2 * layout->n_pairs;
+  sp_solver_options opt = {.jacobian = SP_SOLVER_JAC_AD, .linear = linear, .newton_rtol = 1e-10,
+                           .newton_atol = 1e300, .newton_max_its = 3};
+  sp_solver s = NULL;
+  if (sp_solver_create(comm, &opt, &s) != 0) {
+    fprintf(stderr, "sp_solver_create: %s\n", sp_solver_last_error(s));
+    MPI_Abort(MPI_COMM_WORLD, 1);
+  }
+  CHECK_OK(sp_solver_attach(s, mesh, layout));
+  double *x = malloc(n * sizeof(double));
+  memcpy(x, guess, n * sizeof(double));
+  sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
+  sp_step_report rep;
+  double t0 = MPI_Wtime();
+  for (int k = 0; k < N_ITERATES; ++k) {
+    int rc = sp_solver_step(s, &data, x, &rep);
+    CHECK(rc == 0 && rep.newton_its == 1, "iterate %d: rc %d, %d its: %s", k + 1, rc,
+          rep.newton_its, sp_solver_last_error(s));
+    memcpy(iterates + (size_t)k * n, x, n * sizeof(double));
+  }
+  *seconds = MPI_Wtime() - t0;
+  free(x);
+  sp_solver_destroy(&s);
+}
+
+static int cmd_iterates(int argc, char **argv, int rank, int size) {
+  sp_mesh *mesh;
+  sp_layout *layout;
+  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 40, 40, &mesh));
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 3, &layout));
+  const int n = 2 * layout->n_pairs;
+  double *old = calloc(n, sizeof(double)), *guess = calloc(n, sizeof(double));
+  const double d = sqrt(1e-3 / 8);
+  set_disk(mesh, layout, old, 0, 0.35, 0.5, 0.15, d);
+  set_disk(mesh, layout, old, 1, 0.65, 0.5, 0.15, d);
+  set_disk(mesh, layout, old, 2, 0.5, 0.75, 0.11, d);
+  /* x_0: the old state with a perturbed c, so that every iterate moves. */
+  for (int i = 0; i < n; ++i) guess[i] = old[i] + (i % 2 == 0 ? 0.01 * sin(0.37 * i) : 0.0);
+  double *ref = malloc((size_t)N_ITERATES * n * sizeof(double));
+  double *got = malloc((size_t)N_ITERATES * n * sizeof(double));
+  double t_ref;
+  /* Every rank computes the serial reference alone (the same numbers). */
+  newton_iterates(MPI_COMM_SELF, SP_SOLVER_SUPERLU, mesh, layout, old, guess, ref, &t_ref);
+  if (rank == 0) printf("%d unknowns; serial superlu: 4 iterates in %.2f s\n", n, t_ref);
+  for (int a = 0; a < argc; ++a) {
+    const int kind = linear_kind(argv[a]);
+    CHECK(kind >= 0, "unknown backend %s", argv[a]);
+    if (kind < 0) continue;
+    double t;
+    newton_iterates(MPI_COMM_WORLD, kind, mesh, layout, old, guess, got, &t);
+    for (int k = 0; k < N_ITERATES; ++k) {
+      double diff = 0, scale = 0;
+      for (int i = 0; i < n; ++i) {
+        diff = fmax(diff, fabs(got[(size_t)k * n + i] - ref[(size_t)k * n + i]));
+        scale = fmax(scale, fabs(ref[(size_t)k * n + i]));
+      }
+      if (rank == 0)
+        printf("%s on %d process(es): iterate %d, max difference %.2e (relative %.2e)%s\n", argv[a],
+               size, k + 1, diff, diff / scale, k == N_ITERATES - 1 ? "" : "");
+      CHECK(diff <= 1e-10 * scale, "%s, np %d, iterate %d: relative difference %.3g", argv[a], size,
+            k + 1, diff / scale);
+    }
+    if (rank == 0) printf("%s on %d process(es): 4 iterates in %.2f s\n", argv[a], size, t);
+  }
+  free(old); free(guess); free(ref); free(got);
+  sp_layout_destroy(&layout);
+  sp_mesh_destroy(&mesh);
+  return 0;
+}
+
+/* ---------- cli: the real program under mpirun ---------- */
+
+static int run_mpi(int np, const char *args, char *out, size_t size, double *seconds) {
+  char cmd[4096];
+  snprintf(cmd, sizeof cmd,
+           "OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+           "timeout -s KILL 60 %s %s %d %s %s %s 2>&1",
+           SP_MPIEXEC, SP_MPIEXEC_NUMPROC_FLAG, np, SP_MPIEXEC_PREFLAGS, SP_BINARY, args);
+  struct timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  FILE *p = popen(cmd, "r");
+  if (!p) return -1;
+  size_t n = fread(out, 1, size - 1, p);
+  out[n] = '\0';
+  int status = pclose(p);
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  *seconds = (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+static void expect_failure(const char *what, const char *args, int want_status, const char *needle) {
+  char out[16384];
+  double seconds = 0;
+  int status = run_mpi(2, args, out, sizeof out, &seconds);
+  printf("%s: exit status %d after %.1f s\n", what, status, seconds);
+  CHECK(status == want_status, "%s: exit status %d (want %d), output:\n%s", what, status,
+        want_status, out);
+  CHECK(strstr(out, needle) != NULL, "%s: no '%s' in the output:\n%s", what, needle, out);
+  CHECK(seconds < 50, "%s: took %.1f s", what, seconds);
+}
+
+static int cmd_cli(void) {
+  const char *scene = SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml";
+  char args[4096];
+  system("rm -rf mpi_cli_out");
+  snprintf(args, sizeof args, "run %s/tests/scenes/bad/negative_kappa.yaml --out mpi_cli_out",
+           SP_SOURCE_DIR);
+  expect_failure("bad scene, np 2", args, 2, "model.kappa");
+  snprintf(args, sizeof args,
+           "run %s --out mpi_cli_out --set solver.linear=klu2 --set output.pictures=false", scene);
+  expect_failure("klu2, np 2", args, 2, "solver.linear: klu2 runs on one MPI process only");
+  CHECK(system("test -e mpi_cli_out") != 0, "bad input created the output directory");
+  /* Only rank 0 writes: an unwritable output directory fails there alone,
+   * while rank 1 goes on into the first step's collectives. */
+  snprintf(args, sizeof args,
+           "run %s --out /proc/mpi_compare_cannot_write --set output.pictures=false", scene);
+  expect_failure("unwritable --out, np 2", args, 1, "softpack: error");
+  TEST_DONE();
+}
+
+int main(int argc, char **argv) {
+  if (argc >= 2 && strcmp(argv[1], "cli") == 0) return cmd_cli(); /* no MPI_Init: it runs mpirun */
+  MPI_Init(&argc, &argv);
+  int rank, size;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  int rc = 2;
+  if (argc >= 2 && strcmp(argv[1], "steps") == 0) rc = cmd_steps(argc - 2, argv + 2, rank, size);
+  else if (argc >= 2 && strcmp(argv[1], "iterates") == 0) rc = cmd_iterates(argc - 2, argv + 2, rank, size);
+  else if (rank == 0) fprintf(stderr, "usage: mpi_compare steps|iterates|cli ...\n");
+  /* Every rank's failures count (the comparisons are made on rank 0). */
+  int failures = sp_test_failures + (rc != 0), total = 0;
+  MPI_Allreduce(&failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  if (rank == 0) {
+    if (total) fprintf(stderr, "%d check(s) failed\n", total);
+    else printf("all checks passed\n");
+  }
+  MPI_Finalize();
+  return total ? 1 : 0;
+}
