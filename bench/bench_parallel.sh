@@ -33,9 +33,11 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 # run NP LINEAR TAG SCENE [--set ...]: prints
-#   "steps its total asm fac sol mem_rank0/mem_rank1... unknowns load"
+#   "steps its total asm fac sol mem_rank0/mem_rank1... unknowns load retries"
 # (unknowns: the largest of the run with local supports, else 2 x cells x
-# nodes; load: the machine's 1-minute load average just before the run)
+# nodes; load: the machine's 1-minute load average just before the run;
+# retries: failed Newton attempts retried with a smaller dt, whose time is
+# in the totals but whose iterations are not in "Newton its")
 run() {
   local np=$1 lin=$2 tag=$3 scene=$4
   shift 4
@@ -59,26 +61,28 @@ run() {
     cells=$(tail -1 "$dir/out/energy.csv" | cut -d, -f5)
     unknowns=$((2 * cells * nodes))
   fi
-  echo "$mem $unknowns $load"
+  local retries
+  retries=$(sed -n 's/^softpack: .* steps to .* (\([0-9]*\) failed attempts.*/\1/p' "$dir/log")
+  echo "$mem $unknowns $load $retries"
 }
 
 header() {
   echo
   echo "### $1"
   echo
-  echo "| solver | np | unknowns | steps | Newton its | s/step | s/iteration | assembly/it | factorisation/it | solves/it | speed-up | peak MB per rank | load before |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| solver | np | unknowns | steps | Newton its | s/step | s/iteration | assembly/it | factorisation/it | solves/it | speed-up | peak MB per rank | load before | retries |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 }
 
 # row LIN NP "steps its total asm fac sol mem unknowns" BASE_TOTAL
 row() {
   local lin=$1 np=$2 base=$4
-  read -r steps its total as fa so mem unknowns load <<< "$3"
+  read -r steps its total as fa so mem unknowns load retries <<< "$3"
   awk -v lin="$lin" -v np="$np" -v steps="$steps" -v its="$its" -v total="$total" -v as="$as" \
-      -v fa="$fa" -v so="$so" -v mem="$mem" -v base="$base" -v unk="$unknowns" -v load="$load" 'BEGIN {
-    printf "| %s | %d | %s | %d | %d | %.2f | %.2f | %.3f | %.3f | %.3f | %s | %s | %s |\n", lin, np, unk, steps, its,
+      -v fa="$fa" -v so="$so" -v mem="$mem" -v base="$base" -v unk="$unknowns" -v load="$load" -v retries="$retries" 'BEGIN {
+    printf "| %s | %d | %s | %d | %d | %.2f | %.2f | %.3f | %.3f | %.3f | %s | %s | %s | %s |\n", lin, np, unk, steps, its,
       total / steps, total / its, as / its, fa / its, so / its,
-      (base > 0 ? sprintf("%.2f", base / total) : "-"), mem, load }'
+      (base > 0 ? sprintf("%.2f", base / total) : "-"), mem, load, retries }'
 }
 
 table() {  # table TITLE TAG SKIP_SOLVER SCENE [--set ...]
@@ -114,8 +118,8 @@ for c in "${cases[@]}"; do
           a=$(run "$np" "$lin" p16a inputs/paper/constant_volume_16.yaml --set time.t_end=0.0124)
           b=$(run "$np" "$lin" p16b inputs/paper/constant_volume_16.yaml --set time.t_end=0.0134)
           # the window = second run - first run (memory: the second run's)
-          d=$(paste -d' ' <(echo "$a") <(echo "$b") | awk '{ printf "%d %d %.3f %.3f %.3f %.3f %s %s %s\n",
-                $10 - $1, $11 - $2, $12 - $3, $13 - $4, $14 - $5, $15 - $6, $16, $17, $18 }')
+          d=$(paste -d' ' <(echo "$a") <(echo "$b") | awk '{ printf "%d %d %.3f %.3f %.3f %.3f %s %s %s %d\n",
+                $11 - $1, $12 - $2, $13 - $3, $14 - $4, $15 - $5, $16 - $6, $17, $18, $19, $20 - $10 }')
           [ "$np" = 1 ] && base=$(echo "$d" | cut -d' ' -f3)
           row "$lin" "$np" "$d" "$base"
         done
