@@ -23,6 +23,7 @@
 #include "layout.h"
 #include "mesh.h"
 #include "softpack_solver.h"
+#include "stepper.h"
 
 static sp_model_params paper_model(void) {
   sp_model_params m = {.alpha = 4, .kappa = 1e-3, .lambda = 100, .lambda_b = 100,
@@ -38,11 +39,8 @@ static sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout, int j
     fprintf(stderr, "sp_solver_create: %s\n", sp_solver_last_error(s));
     exit(1);
   }
-  sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
-  sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
-                       layout->pair_cell};
-  if (sp_solver_set_problem(s, &mv, &lv) != 0) {
-    fprintf(stderr, "sp_solver_set_problem: %s\n", sp_solver_last_error(s));
+  if (sp_solver_attach(s, mesh, layout) != SP_OK) {
+    fprintf(stderr, "%s\n", sp_error_message());
     exit(1);
   }
   return s;

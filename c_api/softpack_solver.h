@@ -63,6 +63,11 @@ typedef struct {
   int n_nodes, n_cells, n_pairs;
   const int *node_start;  /**< n_nodes + 1 */
   const int *pair_cell;   /**< n_pairs */
+  /** Node partition (optional): rank r owns nodes rank_first_node[r] ..
+   *  rank_first_node[r+1]-1 (n_ranks + 1 entries, n_ranks = the solver's
+   *  communicator size). NULL: equal node counts per rank. */
+  const int *rank_first_node;
+  int n_ranks;
 } sp_layout_view;
 
 /** Model parameters (MODEL.md). */
@@ -113,6 +118,9 @@ typedef struct {
 /** @brief Create a solver on @p comm with @p options. */
 int sp_solver_create(MPI_Comm comm, const sp_solver_options *options,
                      sp_solver *out);
+
+/** @brief The number of ranks of the solver's communicator (0 on error). */
+int sp_solver_ranks(sp_solver s);
 
 /** @brief (Re)build maps, graph and matrix for a mesh and layout. Cheap to
  *         call again with the same layout; a new layout rebuilds everything. */

@@ -37,9 +37,22 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
   if (mesh.n_nodes != layout.n_nodes)
     throw std::runtime_error("layout and mesh disagree on the node count");
   // Node partition: contiguous node ranges in rank order, so each rank's
-  // DOFs are a contiguous range too (what SuperLU_DIST needs).
+  // DOFs are a contiguous range too (what SuperLU_DIST needs). The C core
+  // balances the ranges by unknowns along an RCB node order (partition.h);
+  // without them, equal node counts.
   const int P = comm.NumProc(), r = comm.MyPID();
-  const long first_node = (long)n_nodes_ * r / P, end_node = (long)n_nodes_ * (r + 1) / P;
+  long first_node = (long)n_nodes_ * r / P, end_node = (long)n_nodes_ * (r + 1) / P;
+  if (layout.rank_first_node) {
+    if (layout.n_ranks != P)
+      throw std::runtime_error("the node partition is for " + std::to_string(layout.n_ranks) +
+                               " ranks, the communicator has " + std::to_string(P));
+    first_node = layout.rank_first_node[r];
+    end_node = layout.rank_first_node[r + 1];
+    if (first_node < 0 || end_node < first_node || end_node > n_nodes_ ||
+        layout.rank_first_node[0] != 0 || layout.rank_first_node[P] != n_nodes_)
+      throw std::runtime_error("the node partition's ranges are not increasing from 0 to the "
+                               "node count");
+  }
   std::vector<int> my_dofs;
   for (long i = first_node; i < end_node; ++i)
     for (int p = node_start_[i]; p < node_start_[i + 1]; ++p) {

@@ -50,6 +50,11 @@ int sp_solver_create(MPI_Comm comm, const sp_solver_options *options, sp_solver 
   return guarded(s, [&] { s->impl.reset(new sp::Solver(comm, *options)); });
 }
 
+int sp_solver_ranks(sp_solver s) {
+  if (!s || !s->impl) return 0;
+  return s->impl->ranks();
+}
+
 int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh, const sp_layout_view *layout) {
   if (!s) return SP_API_ERR + 1;
   return guarded(s, [&] {

@@ -45,12 +45,7 @@ static int checkjac_setup(checkjac *c) {
   sp_model_from_scene(scene, &c->model);
   if (sp_solver_create(MPI_COMM_WORLD, &opt, &c->solver) != 0)
     return sp_error_set(SP_ERR_INPUT, "solver: %s", sp_solver_last_error(c->solver));
-  sp_mesh_view mv = {c->mesh->n_nodes, c->mesh->n_elems, c->mesh->xy, c->mesh->elem,
-                     c->mesh->region};
-  sp_layout_view lv = {c->layout->n_nodes, c->layout->n_cells, c->layout->n_pairs,
-                       c->layout->node_start, c->layout->pair_cell};
-  if (sp_solver_set_problem(c->solver, &mv, &lv) != 0)
-    return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(c->solver));
+  SP_CALL(sp_solver_attach(c->solver, c->mesh, c->layout));
   const size_t n_values = 2 * (size_t)c->layout->n_pairs;
   SP_ALLOC(c->state, n_values);
   SP_ALLOC(c->state_old, n_values);

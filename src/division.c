@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "error.h"
+#include "q1.h"
 
 /** A node within this fraction of the mesh size h of the division line is
  *  "on" it for the sharp cut (round-off in the centre of mass is ~1e-16). */
@@ -103,7 +104,8 @@ static double child_share(double sd, int smooth, double width, double on_line) {
 int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
                       const double *state, int parent,
                       const sp_cell_obs *parent_obs, int smooth, double width,
-                      const sp_layout *new_layout, double *new_state, int child) {
+                      double offset, const sp_layout *new_layout, double *new_state,
+                      int child) {
   SP_CHECK(layout->n_nodes == mesh->n_nodes && new_layout->n_nodes == mesh->n_nodes,
            SP_ERR_INTERNAL, "division split: layouts have %d and %d nodes, the mesh %d",
            layout->n_nodes, new_layout->n_nodes, mesh->n_nodes);
@@ -128,7 +130,8 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
   for (int i = 0; i < mesh->n_nodes; ++i) {
     const int p_old = sp_layout_pair(layout, parent, i);
     if (p_old < 0) continue;
-    const double sd = nx * (mesh->xy[2 * i] - px) + ny * (mesh->xy[2 * i + 1] - py);
+    const double sd =
+        nx * (mesh->xy[2 * i] - px) + ny * (mesh->xy[2 * i + 1] - py) - offset;
     const double share = child_share(sd, smooth, width, on_line);
     const double c = state[2 * p_old], mu = state[2 * p_old + 1];
     /* parent = c - child, not c (1 - H): the two then add up to c. */
@@ -153,6 +156,80 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
       new_state[2 * p_parent + 1] = mu_parent;
     }
   }
+  return SP_OK;
+}
+
+/** Bisection steps of sp_division_balance_offset: the bracket (the cell's
+ *  extent plus a margin) shrinks by 2^-60, below round-off. */
+#define SP_DIVISION_BALANCE_STEPS 60
+
+/** Margin of the bracket, in smoothed-cut widths: H(+-40) differs from 1, 0
+ *  by 4e-18. */
+#define SP_DIVISION_BALANCE_MARGIN 40.0
+
+/** The child's mass for the line shifted by s (sp_division_balance_offset). */
+static double child_mass(int n, const double *w, const double *c, const double *sd,
+                         double s, int smooth, double width, double on_line) {
+  double m = 0;
+  for (int j = 0; j < n; ++j) m += w[j] * c[j] * child_share(sd[j] - s, smooth, width, on_line);
+  return m;
+}
+
+int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
+                               const double *state, int parent,
+                               const sp_cell_obs *parent_obs, int smooth, double width,
+                               double *offset) {
+  *offset = 0.0;
+  /* w_i = int phi_i over the parent's whole elements (sp_cells_observe's rule) */
+  const size_t nn = (size_t)mesh->n_nodes;
+  double *buffer; /* one block: nothing leaks on the error return */
+  SP_ALLOC(buffer, 4 * nn);
+  double *w_node = buffer, *w = buffer + nn, *c = buffer + 2 * nn, *sd = buffer + 3 * nn;
+  for (int e = 0; e < mesh->n_elems; ++e) {
+    const int *nodes = mesh->elem + 4 * e;
+    int whole = 1;
+    for (int b = 0; b < 4 && whole; ++b) whole = sp_layout_pair(layout, parent, nodes[b]) >= 0;
+    if (!whole) continue;
+    double xy[4][2];
+    sp_mesh_elem_xy(mesh, e, xy);
+    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+      double N[4], dNdx[4][2], x[2], w;
+      sp_q1_point(xy, q, N, dNdx, x, &w);
+      for (int b = 0; b < 4; ++b) w_node[nodes[b]] += w * N[b];
+    }
+  }
+  /* the parent's nodes: weight, value, signed distance from the centre line */
+  int n = 0;
+  double px, py, dx, dy;
+  sp_division_axis(parent_obs, &px, &py, &dx, &dy);
+  double lo = 0, hi = 0, total = 0;
+  for (int i = 0; i < mesh->n_nodes; ++i) {
+    const int p = sp_layout_pair(layout, parent, i);
+    if (p < 0 || w_node[i] == 0) continue;
+    w[n] = w_node[i];
+    c[n] = state[2 * p];
+    sd[n] = -dy * (mesh->xy[2 * i] - px) + dx * (mesh->xy[2 * i + 1] - py);
+    total += w[n] * c[n];
+    if (sd[n] < lo) lo = sd[n];
+    if (sd[n] > hi) hi = sd[n];
+    ++n;
+  }
+  const double margin = smooth ? SP_DIVISION_BALANCE_MARGIN * width : mesh->h;
+  lo -= margin;
+  hi += margin;
+  const double on_line = SP_DIVISION_ON_LINE_FRACTION * mesh->h;
+  /* M(lo) ~ total > total / 2 > M(hi) ~ 0: keep M(lo) >= half >= M(hi) */
+  const double half = 0.5 * total;
+  double m_lo = child_mass(n, w, c, sd, lo, smooth, width, on_line);
+  double m_hi = child_mass(n, w, c, sd, hi, smooth, width, on_line);
+  for (int it = 0; it < SP_DIVISION_BALANCE_STEPS && m_lo >= half && m_hi <= half; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    const double m_mid = child_mass(n, w, c, sd, mid, smooth, width, on_line);
+    if (m_mid >= half) { lo = mid; m_lo = m_mid; }
+    else { hi = mid; m_hi = m_mid; }
+  }
+  *offset = fabs(m_lo - half) <= fabs(m_hi - half) ? lo : hi;
+  free(buffer);
   return SP_OK;
 }
 

@@ -154,9 +154,11 @@ void sp_division_axis(const sp_cell_obs *obs, double *px, double *py,
  * @brief Split cell @p parent into itself and a new cell @p child on a layout
  *        with one more cell (paper section 2.3).
  *
- * With the axis of sp_division_axis (centre Xc, direction v1) and the unit
- * normal n = v2 = (-v1_y, v1_x) (v1 turned by +90 degrees), the signed
- * distance of node X is sd = n . (X - Xc). At each node the parent's value
+ * With the axis of sp_division_axis (centre Xc, direction v1), the unit
+ * normal n = v2 = (-v1_y, v1_x) (v1 turned by +90 degrees) and the line
+ * moved by @p offset along n (0: through the centre of mass, the paper;
+ * sp_division_balance_offset: the line that halves the mass), the signed
+ * distance of node X is sd = n . (X - Xc) - offset. At each node the parent's value
  * c is shared as
  *     c_child = c H(sd),   c_parent = c - c_child,
  * so c_parent + c_child = c at every node and, the mass being linear in the
@@ -192,6 +194,7 @@ void sp_division_axis(const sp_cell_obs *obs, double *px, double *py,
  * @param[in] parent_obs its observables in @p state (the axis)
  * @param[in] smooth 0: sharp cut; 1: smoothed
  * @param[in] width the smoothed cut's width (> 0; ignored when sharp)
+ * @param[in] offset the line's shift along n from the centre of mass
  * @param[in] new_layout layout->n_cells + 1 cells on the same nodes; the
  *            child must have a pair wherever it receives a nonzero value
  *            (sharp: the parent's nodes with sd > -1e-9 h; smoothed: all
@@ -205,7 +208,34 @@ void sp_division_axis(const sp_cell_obs *obs, double *px, double *py,
 int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
                       const double *state, int parent,
                       const sp_cell_obs *parent_obs, int smooth, double width,
-                      const sp_layout *new_layout, double *new_state, int child);
+                      double offset, const sp_layout *new_layout, double *new_state,
+                      int child);
+
+/**
+ * @brief The shift of the division line along its normal n that splits the
+ *        parent's mass into equal halves (`division.line: equal_mass`).
+ *
+ * The line through the centre of mass halves only a symmetric cell: a
+ * packed, egg-shaped parent is split 46/54 by it (docs/paper-runs.md, run
+ * 1). The child's mass after sp_division_split with offset s,
+ *     M(s) = sum_i w_i c_i H(n . (X_i - Xc) - s),
+ * where w_i = int phi_i over the parent's elements (all four nodes in its
+ * support: the rule of sp_cells_observe, so M(s) is exactly the mass the
+ * observables will report), decreases with s; bisection finds M(s) =
+ * M_parent / 2. The smoothed cut's M is continuous, so the halves agree to
+ * round-off; the sharp cut's M jumps by one node's share, and the offset
+ * returned is the side of the last jump closer to the half.
+ * The axis (direction) is unchanged: the cell is still cut across its
+ * length; only the line's position moves (by much less than the cell's
+ * radius for any parent that is nearly convex).
+ *
+ * @param[out] offset the shift s (0 for a cell whose centre line halves it)
+ * @return SP_OK; SP_ERR_MEMORY
+ */
+int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
+                               const double *state, int parent,
+                               const sp_cell_obs *parent_obs, int smooth, double width,
+                               double *offset);
 
 /**
  * @brief Birth records of both daughters after a split at time @p t: birth

@@ -70,10 +70,12 @@ static int cmd_run(int argc, char **argv, int rank) {
            "%.2e, at most %ld unknowns\n",
            sum.layout_changes, sum.t_layout, sum.support_mass_correction, sum.unknowns_max);
   if (rc == SP_OK && rank == 0)
-    printf("softpack: %d steps to t = %.6g (%d failed attempts retried, smallest dt %.3g), "
+    printf("softpack: %d steps to t = %.6g (%d failed attempts retried, %d of them for an "
+           "energy rise; smallest dt %.3g), "
            "%ld Newton iterations, %.1f s (assembly %.1f, factorisation %.1f, solves %.1f); "
            "output in %s\n",
-           sum.steps, sum.t_final, sum.failed_attempts, sum.dt_smallest, sum.newton_its,
+           sum.steps, sum.t_final, sum.failed_attempts, sum.energy_rejections,
+           sum.dt_smallest, sum.newton_its,
            sum.wall_seconds, sum.t_assembly, sum.t_factor, sum.t_solve, out_dir);
   sp_scene_destroy(&scene);
   free(sets);

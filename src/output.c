@@ -36,6 +36,7 @@ struct sp_output_s {
   int n_fields, cap_fields;
   int *field_step;      /**< step of each .vtu written, in write order */
   double *field_t;      /**< its time */
+  int parallel;         /**< 1: the fields are .pvtu files of pieces */
 };
 
 /* ------------------------------------------------------------------------ */
@@ -382,10 +383,22 @@ static int32_t sp_node_cell_id(const sp_layout *l, const double *state,
   return id;
 }
 
-/** Write the whole .vtu to @p f (errors are left in ferror(f)). */
+/** The points and elements of one .vtu: all of the mesh, or (a piece of
+ *  an MPI run) a subset of the elements and the nodes they use. */
+typedef struct {
+  int n_nodes, n_elems;
+  const int *node;     /**< NULL: all nodes; else the global node of each point */
+  const int *elem;     /**< NULL: all elements; else the elements of the piece */
+  const int *local;    /**< global node -> point index (pieces only) */
+} sp_vtu_part;
+
+static int part_node(const sp_vtu_part *p, int j) { return p->node ? p->node[j] : j; }
+static int part_elem(const sp_vtu_part *p, int j) { return p->elem ? p->elem[j] : j; }
+
+/** Write a .vtu to @p f (errors are left in ferror(f)). */
 static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
-                         const double *state, int step, double t) {
-  const int nn = mesh->n_nodes, ne = mesh->n_elems;
+                         const double *state, int step, double t, const sp_vtu_part *part) {
+  const int nn = part->n_nodes, ne = part->n_elems;
   const uint16_t probe = 1;
   const int little = *(const unsigned char *)&probe == 1;
   sp_b64 b;
@@ -406,7 +419,8 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
   fprintf(f, "    <Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\">\n", nn,
           ne);
 
-  /* Point data: c_k, mu_k per cell (0 off the support), then cell_id. */
+  /* Point data: c_k, mu_k per cell (0 off the support), then cell_id
+   * (and node_id, the global node number, in the pieces of MPI runs). */
   fprintf(f, "      <PointData Scalars=\"cell_id\">\n");
   for (int k = 0; k < l->n_cells; ++k)
     for (int field = 0; field < 2; ++field) {
@@ -414,8 +428,8 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
       snprintf(name, sizeof name, "%s_%d", field ? "mu" : "c", k + 1);
       sp_vtu_array_open(f, "Float64", name, 1);
       sp_b64_begin_array(&b, f, (uint64_t)nn * sizeof(double));
-      for (int i = 0; i < nn; ++i) {
-        int p = sp_layout_pair(l, k, i);
+      for (int j = 0; j < nn; ++j) {
+        int p = sp_layout_pair(l, k, part_node(part, j));
         double v = p >= 0 ? state[2 * p + field] : 0.0;
         sp_b64_put(&b, &v, sizeof v);
       }
@@ -424,19 +438,29 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
     }
   sp_vtu_array_open(f, "Int32", "cell_id", 1);
   sp_b64_begin_array(&b, f, (uint64_t)nn * sizeof(int32_t));
-  for (int i = 0; i < nn; ++i) {
-    int32_t id = sp_node_cell_id(l, state, i);
+  for (int j = 0; j < nn; ++j) {
+    int32_t id = sp_node_cell_id(l, state, part_node(part, j));
     sp_b64_put(&b, &id, sizeof id);
   }
   sp_b64_end(&b);
   sp_vtu_array_close(f);
+  if (part->node) {
+    sp_vtu_array_open(f, "Int32", "node_id", 1);
+    sp_b64_begin_array(&b, f, (uint64_t)nn * sizeof(int32_t));
+    for (int j = 0; j < nn; ++j) {
+      int32_t id = part->node[j];
+      sp_b64_put(&b, &id, sizeof id);
+    }
+    sp_b64_end(&b);
+    sp_vtu_array_close(f);
+  }
   fprintf(f, "      </PointData>\n");
 
   fprintf(f, "      <CellData Scalars=\"region\">\n");
   sp_vtu_array_open(f, "Int32", "region", 1);
   sp_b64_begin_array(&b, f, (uint64_t)ne * sizeof(int32_t));
-  for (int e = 0; e < ne; ++e) {
-    int32_t r = mesh->region ? mesh->region[e] : 0;
+  for (int j = 0; j < ne; ++j) {
+    int32_t r = mesh->region ? mesh->region[part_elem(part, j)] : 0;
     sp_b64_put(&b, &r, sizeof r);
   }
   sp_b64_end(&b);
@@ -447,7 +471,8 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
   fprintf(f, "      <Points>\n");
   sp_vtu_array_open(f, "Float64", "Points", 3);
   sp_b64_begin_array(&b, f, (uint64_t)nn * 3 * sizeof(double));
-  for (int i = 0; i < nn; ++i) {
+  for (int j = 0; j < nn; ++j) {
+    const int i = part_node(part, j);
     double x[3] = {mesh->xy[2 * i], mesh->xy[2 * i + 1], 0.0};
     sp_b64_put(&b, x, sizeof x);
   }
@@ -459,9 +484,10 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
   fprintf(f, "      <Cells>\n");
   sp_vtu_array_open(f, "Int32", "connectivity", 1);
   sp_b64_begin_array(&b, f, (uint64_t)ne * 4 * sizeof(int32_t));
-  for (int e = 0; e < ne; ++e)
+  for (int j = 0; j < ne; ++j)
     for (int a = 0; a < 4; ++a) {
-      int32_t n = mesh->elem[4 * e + a];
+      const int node = mesh->elem[4 * part_elem(part, j) + a];
+      int32_t n = part->local ? part->local[node] : node;
       sp_b64_put(&b, &n, sizeof n);
     }
   sp_b64_end(&b);
@@ -495,8 +521,8 @@ static int sp_pvd_write(const struct sp_output_s *o) {
                     "byte_order=\"LittleEndian\">\n  <Collection>\n");
   for (int i = 0; i < o->n_fields; ++i)
     sp_strbuf_add(&b, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" "
-                      "file=\"fields_%06d.vtu\"/>\n",
-                  o->field_t[i], o->field_step[i]);
+                      "file=\"fields_%06d.%s\"/>\n",
+                  o->field_t[i], o->field_step[i], o->parallel ? "pvtu" : "vtu");
   sp_strbuf_add(&b, "  </Collection>\n</VTKFile>\n");
   int rc;
   char *path = sp_strfmt("%s/fields.pvd", o->dir);
@@ -547,11 +573,88 @@ int sp_output_fields(sp_output out, const sp_mesh *mesh,
   FILE *f;
   int rc = sp_tmp_open(path, &tmp, &f);
   if (rc == SP_OK) {
-    sp_vtu_write(f, mesh, layout, state, step, t);
+    const sp_vtu_part all = {mesh->n_nodes, mesh->n_elems, NULL, NULL, NULL};
+    sp_vtu_write(f, mesh, layout, state, step, t, &all);
     rc = sp_tmp_commit(path, tmp, f);
   }
   free(path);
   SP_CALL(rc);
+  SP_CALL(sp_fields_record(out, step, t));
+  return sp_pvd_write(out);
+}
+
+int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout *layout,
+                           const double *state, int step, double t, int rank,
+                           int first_node, int end_node) {
+  SP_CHECK(mesh->n_nodes == layout->n_nodes && first_node >= 0 && first_node <= end_node &&
+           end_node <= mesh->n_nodes && step >= 0 && rank >= 0, SP_ERR_INTERNAL,
+           "output piece: nodes %d..%d of %d (layout %d), step %d, rank %d", first_node,
+           end_node, mesh->n_nodes, layout->n_nodes, step, rank);
+  const size_t nn = (size_t)mesh->n_nodes, ne = (size_t)mesh->n_elems;
+  int *block; /* elements of the piece, its nodes, global -> point */
+  SP_ALLOC(block, ne + 2 * nn);
+  int *elems = block, *nodes = block + ne, *local = block + ne + nn;
+  int n_elems = 0, n_nodes = 0;
+  for (size_t i = 0; i < nn; ++i) local[i] = -1;
+  for (size_t e = 0; e < ne; ++e) {
+    const int *en = mesh->elem + 4 * e;
+    if (en[0] < first_node || en[0] >= end_node) continue; /* the solver's rule */
+    elems[n_elems++] = (int)e;
+    for (int a = 0; a < 4; ++a) local[en[a]] = 0;
+  }
+  for (size_t i = 0; i < nn; ++i)
+    if (local[i] == 0) {
+      local[i] = n_nodes;
+      nodes[n_nodes++] = (int)i;
+    }
+  const sp_vtu_part part = {n_nodes, n_elems, nodes, elems, local};
+  char *path = sp_strfmt("%s/fields_%06d_p%d.vtu", dir, step, rank);
+  char *tmp = NULL;
+  FILE *f = NULL;
+  int rc = path ? sp_tmp_open(path, &tmp, &f)
+                : sp_error_set(SP_ERR_MEMORY, "out of memory naming a .vtu in '%s'", dir);
+  if (rc == SP_OK) {
+    sp_vtu_write(f, mesh, layout, state, step, t, &part);
+    rc = sp_tmp_commit(path, tmp, f);
+  }
+  free(path);
+  free(block);
+  return rc;
+}
+
+int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, double t,
+                          int n_ranks) {
+  SP_CHECK(step >= 0 && n_ranks >= 1, SP_ERR_INTERNAL, "output: step %d, %d ranks", step,
+           n_ranks);
+  sp_strbuf b = {0};
+  sp_strbuf_add(&b, "<?xml version=\"1.0\"?>\n"
+                    "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" "
+                    "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+                    "  <PUnstructuredGrid GhostLevel=\"0\">\n"
+                    "    <PPointData Scalars=\"cell_id\">\n");
+  for (int k = 0; k < layout->n_cells; ++k)
+    sp_strbuf_add(&b, "      <PDataArray type=\"Float64\" Name=\"c_%d\"/>\n"
+                      "      <PDataArray type=\"Float64\" Name=\"mu_%d\"/>\n", k + 1, k + 1);
+  sp_strbuf_add(&b, "      <PDataArray type=\"Int32\" Name=\"cell_id\"/>\n"
+                    "      <PDataArray type=\"Int32\" Name=\"node_id\"/>\n"
+                    "    </PPointData>\n"
+                    "    <PCellData Scalars=\"region\">\n"
+                    "      <PDataArray type=\"Int32\" Name=\"region\"/>\n"
+                    "    </PCellData>\n"
+                    "    <PPoints>\n"
+                    "      <PDataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\"/>\n"
+                    "    </PPoints>\n");
+  for (int r = 0; r < n_ranks; ++r)
+    sp_strbuf_add(&b, "    <Piece Source=\"fields_%06d_p%d.vtu\"/>\n", step, r);
+  sp_strbuf_add(&b, "  </PUnstructuredGrid>\n</VTKFile>\n");
+  char *path = sp_strfmt("%s/fields_%06d.pvtu", out->dir, step);
+  int rc = b.oom || !path ? sp_error_set(SP_ERR_MEMORY, "out of memory writing a .pvtu in '%s'",
+                                         out->dir)
+                          : sp_write_file_atomic(path, b.s, b.len);
+  free(path);
+  free(b.s);
+  SP_CALL(rc);
+  out->parallel = 1;
   SP_CALL(sp_fields_record(out, step, t));
   return sp_pvd_write(out);
 }

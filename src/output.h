@@ -43,6 +43,24 @@ int sp_output_fields(sp_output out, const sp_mesh *mesh,
                      const sp_layout *layout, const double *state, int step,
                      double t);
 
+/**
+ * @brief MPI runs: write this rank's piece fields_<step>_p<rank>.vtu: the
+ *        elements whose first node is in [first_node, end_node) (the rule
+ *        by which the solver's ranks assemble) and the nodes they use, with
+ *        the arrays of sp_output_fields plus node_id (the global node). Any
+ *        rank may call it; it needs only the output directory.
+ */
+int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout *layout,
+                           const double *state, int step, double t, int rank,
+                           int first_node, int end_node);
+
+/**
+ * @brief MPI runs, rank 0: write fields_<step>.pvtu naming the pieces of
+ *        ranks 0 .. n_ranks-1, and list it in fields.pvd.
+ */
+int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, double t,
+                          int n_ranks);
+
 /** @brief Append one row to divisions.csv: t,step,parent,child,axis_angle,
  *         parent_mass_before,parent_mass_after,child_mass_after (cells
  *         numbered from 1; the angle is the division line's, from x). */

@@ -132,6 +132,8 @@ static const cyaml_strval_t sp_division_words[] = {
     {"none", SP_DIVIDE_NONE}, {"age", SP_DIVIDE_BY_AGE}, {"mass", SP_DIVIDE_BY_MASS}};
 static const cyaml_strval_t sp_cut_words[] = {
     {"sharp", SP_CUT_SHARP}, {"smooth", SP_CUT_SMOOTH}};
+static const cyaml_strval_t sp_line_words[] = {
+    {"centre", SP_LINE_CENTRE}, {"equal_mass", SP_LINE_EQUAL_MASS}};
 static const cyaml_strval_t sp_support_words[] = {
     {"auto", SP_SUPPORT_AUTO}, {"full", SP_SUPPORT_FULL}, {"local", SP_SUPPORT_LOCAL}};
 /* The YAML 1.1 booleans; the first word of each value is the one printed. */
@@ -247,6 +249,10 @@ static const sp_key sp_keys[] = {
     KEY_INT(SP_SEC_TIME, "max_retries", time.max_retries, 30, AT_LEAST(1),
             AT_MOST(1000), "-",
             "failed attempts of one step before the run stops"),
+    KEY_BOOL(SP_SEC_TIME, "energy_guard", time.energy_guard, 0, "-",
+             "reject a step whose energy rises while no source, division or "
+             "shape term acts (backward Euler is energy-stable only for small "
+             "dt) and retry it with dt x shrink"),
     /* noise */
     KEY_FLOAT(SP_SEC_NOISE, "background", noise.background, 0.0,
               AT_LEAST(0.0), AT_MOST(1.0), "-",
@@ -309,6 +315,11 @@ static const sp_key sp_keys[] = {
              "-",
              "the split: sharp (the paper) or smooth (tanh of the distance "
              "to the division line, width d)"),
+    KEY_ENUM(SP_SEC_DIVISION, "line", division.line, SP_LINE_CENTRE, sp_line_words,
+             "-",
+             "the division line (along the cell's length axis v1): through "
+             "the centre of mass (the paper) or moved along its normal so "
+             "the daughters get equal masses"),
     KEY_FLOAT(SP_SEC_DIVISION, "observe_threshold", division.observe_threshold,
               0.05, AT_LEAST(0.0), BELOW(0.5), "-",
               "centre, inertia and the mass criterion count c_k only where "

@@ -55,6 +55,8 @@ typedef struct {
   double grow;      /**< dt factor after grow_after successes (> 1) */
   int grow_after;   /**< consecutive successes before dt grows */
   int max_retries;  /**< failed attempts of one step before the run stops */
+  int energy_guard; /**< reject (and retry with a smaller dt) a step whose
+                         energy rises although nothing injects energy */
 } sp_scene_time;
 
 /** One initial cell. */
@@ -93,6 +95,8 @@ typedef enum {
   SP_DIVIDE_BY_MASS = 2
 } sp_division_kind;
 typedef enum { SP_CUT_SHARP = 0, SP_CUT_SMOOTH = 1 } sp_cut_kind;
+/** Where the division line runs (its direction is always v1). */
+typedef enum { SP_LINE_CENTRE = 0, SP_LINE_EQUAL_MASS = 1 } sp_line_kind;
 
 /** division: when and how cells divide (paper algorithms 1 and 2). */
 typedef struct {
@@ -104,6 +108,8 @@ typedef struct {
   int n_div;             /**< algorithm 2: steps at dt_bar 10^-m */
   int m;                 /**< algorithm 2: exponent */
   sp_cut_kind cut;       /**< sharp (paper) or smooth (tanh) */
+  sp_line_kind line;     /**< through the centre of mass (paper) or moved
+                              along its normal to halve the mass */
   double observe_threshold; /**< c below this is left out of centre,
                                  inertia and the mass criterion */
 } sp_scene_division;

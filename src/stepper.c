@@ -14,6 +14,7 @@
 #include "render.h"
 #include "shape.h"
 #include "source.h"
+#include "partition.h"
 #include "support.h"
 
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
@@ -44,10 +45,17 @@ void sp_model_from_scene(const sp_scene *scene, sp_model_params *model) {
 }
 
 int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *layout) {
+  const int n_ranks = sp_solver_ranks(solver);
+  SP_CHECK(n_ranks >= 1, SP_ERR_INTERNAL, "solver setup: the solver has no communicator");
+  int *first_node;
+  SP_ALLOC(first_node, (size_t)n_ranks + 1);
+  sp_partition_ranges(layout, n_ranks, first_node);
   sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
   sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
-                       layout->pair_cell};
-  if (sp_solver_set_problem(solver, &mv, &lv) != 0)
+                       layout->pair_cell, first_node, n_ranks};
+  const int failed = sp_solver_set_problem(solver, &mv, &lv) != 0;
+  free(first_node);
+  if (failed)
     return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(solver));
   return SP_OK;
 }
@@ -75,7 +83,8 @@ typedef struct {
   int n_energy, cap_energy;
   double *division_t; /* division times, marked on energy.png */
   int n_divisions;
-  int rank;
+  int rank, n_ranks;
+  const char *out_dir;   /* the output directory (every rank writes its piece) */
   /* the cell registry */
   sp_cell_birth *birth;
   int *source_on;
@@ -124,8 +133,21 @@ static int record_energy(sp_run *run, int step, double t, double dt, int its) {
 }
 
 static int write_snapshot(sp_run *run, int step, double t) {
-  if (run->rank != 0) return SP_OK;
-  SP_CALL(sp_output_fields(run->output, run->mesh, run->layout, run->state, step, t));
+  if (run->n_ranks > 1) { /* a piece per rank, the .pvtu by rank 0 */
+    int *first_node;
+    SP_ALLOC(first_node, (size_t)run->n_ranks + 1);
+    sp_partition_ranges(run->layout, run->n_ranks, first_node);
+    int rc = sp_output_fields_piece(run->out_dir, run->mesh, run->layout, run->state, step, t,
+                                    run->rank, first_node[run->rank],
+                                    first_node[run->rank + 1]);
+    free(first_node);
+    SP_CALL(rc);
+    if (run->rank != 0) return SP_OK;
+    SP_CALL(sp_output_fields_pvtu(run->output, run->layout, step, t, run->n_ranks));
+  } else {
+    if (run->rank != 0) return SP_OK;
+    SP_CALL(sp_output_fields(run->output, run->mesh, run->layout, run->state, step, t));
+  }
   char path[4096];
   if (run->scene->output.pictures) {
     snprintf(path, sizeof path, "%s/cells_%06d.png", sp_output_dir(run->output), step);
@@ -211,8 +233,15 @@ static int divide_cell(sp_run *run, int parent, double t, int step) {
   }
   const sp_cell_obs parent_obs = run->obs[parent];
   const int smooth = run->scene->division.cut == SP_CUT_SMOOTH;
-  int rc = sp_division_split(run->mesh, run->layout, run->state, parent, &parent_obs, smooth,
-                             sp_scene_interface_width(run->scene), new_layout, new_state, child);
+  const double width = sp_scene_interface_width(run->scene);
+  double offset = 0.0;
+  int rc = SP_OK;
+  if (run->scene->division.line == SP_LINE_EQUAL_MASS)
+    rc = sp_division_balance_offset(run->mesh, run->layout, run->state, parent, &parent_obs,
+                                    smooth, width, &offset);
+  if (rc == SP_OK)
+    rc = sp_division_split(run->mesh, run->layout, run->state, parent, &parent_obs, smooth,
+                           width, offset, new_layout, new_state, child);
   if (rc != SP_OK) {
     free(new_state); free(new_old); free(new_source);
     sp_layout_destroy(&new_layout);
@@ -275,6 +304,38 @@ static int divide_due_cells(sp_run *run, double t_old, double t, int step,
   return SP_OK;
 }
 
+/** Relative rise of the energy over a passive step that time.energy_guard
+ *  tolerates: Newton's tolerance and round-off move a converged energy by
+ *  far less (~1e-13 relative in the tests). */
+#define SP_ENERGY_GUARD_TOLERANCE 1e-10
+
+/** Whether any cell's source may inject mass (and energy) in this step. */
+static int any_source_on(int n_cells, const int *source_on, double rate) {
+  if (!(rate > 0) || !source_on) return 0;
+  for (int k = 0; k < n_cells; ++k)
+    if (source_on[k]) return 1;
+  return 0;
+}
+
+/** time.energy_guard: *rose = 1 (with the reason) when the energy of the
+ *  converged state is above the last recorded one (that of c^n, after the
+ *  previous step's divisions and support changes) by more than the
+ *  tolerance. Only for steps without source, division or shape term, whose
+ *  exact flow never raises the energy. */
+static int energy_rose(sp_run *run, char *reason, size_t reason_size, int *rose) {
+  *rose = 0;
+  sp_energy_parts parts;
+  if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
+    return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
+  const double e_new = parts.bulk + parts.gradient + parts.repulsion + parts.buffer;
+  const double e_old = run->energy_total[run->n_energy - 1];
+  if (e_new <= e_old + SP_ENERGY_GUARD_TOLERANCE * fabs(e_old)) return SP_OK;
+  *rose = 1;
+  snprintf(reason, reason_size, "the energy rose from %.10g to %.10g (time.energy_guard)",
+           e_old, e_new);
+  return SP_OK;
+}
+
 /** The time loop proper. */
 static int run_steps(sp_run *run, sp_run_summary *sum) {
   const sp_scene_time *tc = &run->scene->time;
@@ -329,6 +390,15 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                         sp_solver_last_error(run->solver));
       break;
     }
+    if (solved == 0 && tc->energy_guard && !shape_on &&
+        !any_source_on(run->layout->n_cells, run->source_on, run->scene->source.rate)) {
+      rc = energy_rose(run, report.reason, sizeof report.reason, &solved);
+      if (rc != SP_OK) break;
+      sum->energy_rejections += solved;
+      if (solved && run->rank == 0)
+        fprintf(stderr, "softpack: step %d at t = %.6g, dt = %.3g: %s; retried with dt x %g\n",
+                step + 1, t, dt_try, report.reason, tc->shrink);
+    }
     if (solved == 1) { /* never accept: shrink and retry from the last good state */
       memcpy(run->state, run->state_old, n_values * sizeof(double));
       ++failures;
@@ -338,7 +408,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       if (failures > tc->max_retries || dt < tc->dt_min) {
         int rc_out = write_snapshot(run, step, t);
         rc = sp_error_set(SP_ERR_SOLVER,
-                          "Newton failed on step %d at t = %.6g after %d attempts "
+                          "step %d at t = %.6g failed %d attempts "
                           "(last dt = %.3g; time.max_retries = %d, time.dt_min = %.3g): %s. "
                           "The last good state (t = %.6g) is written%s.",
                           step + 1, t, failures, dt_try, tc->max_retries, tc->dt_min,
@@ -416,9 +486,37 @@ static void run_free(sp_run *run) {
   sp_support_destroy(&run->support);
 }
 
+/** Renumber the mesh nodes in RCB order (partition.h), for every number of
+ *  ranks, after the initial fields were drawn in the mesh's own numbering
+ *  (so the seeded noise does not depend on the numbering) and carry the
+ *  fields along. The layout is still the full one, node-major. */
+static int renumber_rcb(sp_run *run) {
+  const int nn = run->mesh->n_nodes, nc = run->layout->n_cells;
+  SP_CHECK(run->layout->n_pairs == nn * nc, SP_ERR_INTERNAL,
+           "renumbering: the layout must be the full one");
+  int *order;
+  SP_ALLOC(order, (size_t)nn);
+  double *state = malloc(sizeof(double) * 2 * (size_t)run->layout->n_pairs + 1);
+  int rc = state ? sp_partition_rcb_order(run->mesh, order)
+                 : sp_error_set(SP_ERR_MEMORY, "out of memory renumbering the mesh");
+  if (rc == SP_OK) rc = sp_partition_renumber(run->mesh, order);
+  if (rc == SP_OK) {
+    for (int j = 0; j < nn; ++j)
+      memcpy(state + 2 * (size_t)j * nc, run->state + 2 * (size_t)order[j] * nc,
+             2 * (size_t)nc * sizeof(double));
+    free(run->state);
+    run->state = state;
+    state = NULL;
+  }
+  free(state);
+  free(order);
+  return rc;
+}
+
 static int run_setup(sp_run *run, MPI_Comm comm) {
   const sp_scene *scene = run->scene;
   MPI_Comm_rank(comm, &run->rank);
+  MPI_Comm_size(comm, &run->n_ranks);
   SP_CALL(sp_mesh_from_scene(scene, &run->mesh));
   SP_CALL(sp_layout_create_full(run->mesh->n_nodes, scene->n_cells, &run->layout));
   sp_solver_options opt;
@@ -426,7 +524,6 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   sp_model_from_scene(scene, &run->model);
   if (sp_solver_create(comm, &opt, &run->solver) != 0)
     return sp_error_set(SP_ERR_INPUT, "solver: %s", sp_solver_last_error(run->solver));
-  SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
   const int n = scene->n_cells;
   SP_ALLOC(run->state, n_values);
@@ -437,6 +534,8 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   SP_ALLOC(run->source_on, n);
   SP_ALLOC(run->division_skipped, n);
   SP_CALL(sp_cells_initial_state(scene, run->mesh, run->layout, run->state));
+  SP_CALL(renumber_rcb(run));
+  SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   /* the registry: every initial cell is born at t = 0 */
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            scene->division.observe_threshold, run->obs));
@@ -491,11 +590,17 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
 int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
                    sp_run_summary *summary) {
   sp_run_summary sum = {0};
-  sp_run run = {.scene = scene, .sum = &sum};
+  sp_run run = {.scene = scene, .sum = &sum, .out_dir = out_dir};
   const double t0 = wall_clock();
   int rc = run_setup(&run, comm);
   /* Only now, with the input known good, does anything get written. */
   if (rc == SP_OK && run.rank == 0) rc = sp_output_open(out_dir, &run.output);
+  if (run.n_ranks > 1) { /* the other ranks write pieces into rank 0's directory */
+    int failed = rc != SP_OK, any_failed = 0;
+    MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, comm);
+    if (any_failed && !failed)
+      rc = sp_error_set(SP_ERR_IO, "another rank failed before the run began (see its message)");
+  }
   if (rc == SP_OK) rc = run_steps(&run, &sum);
   sum.wall_seconds = wall_clock() - t0;
   if (summary) *summary = sum;

@@ -23,6 +23,8 @@ extern "C" {
 typedef struct {
   int steps;           /**< accepted steps */
   int failed_attempts; /**< Newton failures that were retried */
+  int energy_rejections; /**< of those: converged steps rejected by
+                              time.energy_guard (the energy rose) */
   long newton_its;     /**< Newton iterations of accepted steps */
   double t_final;      /**< time reached */
   double dt_smallest;  /**< smallest accepted dt */

@@ -6,7 +6,9 @@
  *     every rank runs it together (MPI_COMM_WORLD) into mpi_LABEL_np<P>;
  *     rank 0 compares the CSVs: same steps, times and cell counts, the same
  *     divisions (step, parent, child), energies equal to 1e-9 relative (each
- *     part to 1e-9 of the total), cell masses to 1e-10 relative.
+ *     part to 1e-9 of the total), cell masses to 1e-10 relative; with
+ *     P > 1, the .pvtu pieces cover the mesh once and hold the one-process
+ *     fields (compare_fields).
  *
  *   mpi_compare iterates LINEAR...
  *     The first Newton iterates of one step (three touching cells, 40 x 40
@@ -20,6 +22,7 @@
  *     60 s (timeout -s KILL) with the right status and the message.
  */
 #include <errno.h>
+#include <stdint.h>
 #include <mpi.h>
 #include <string.h>
 #include <sys/wait.h>
@@ -160,6 +163,144 @@ static void compare_runs(const char *ref, const char *par) {
   free(er.v); free(ep.v); free(cr.v); free(cp.v); free(dr.v); free(dp.v);
 }
 
+/* ---------- .vtu files (inline base64, UInt64 headers, as output.c writes) ---------- */
+
+/** The whole file as a string (NULL if unreadable). */
+static char *slurp(const char *path) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  const long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *s = malloc((size_t)n + 1);
+  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) { free(s); s = NULL; }
+  if (s) s[n] = 0;
+  fclose(f);
+  return s;
+}
+
+static int b64_value(char c) {
+  if (c >= 'A' && c <= 'Z') return c - 'A';
+  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+  if (c >= '0' && c <= '9') return c - '0' + 52;
+  return c == '+' ? 62 : c == '/' ? 63 : -1;
+}
+
+/** Decode base64 from s up to the next '<' into out (at most cap bytes). */
+static size_t b64_decode(const char *s, unsigned char *out, size_t cap) {
+  size_t n = 0;
+  unsigned acc = 0;
+  int bits = 0;
+  for (; *s && *s != '<'; ++s) {
+    const int v = b64_value(*s);
+    if (v < 0) continue; /* whitespace, '=' padding */
+    acc = (acc << 6) | (unsigned)v;
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      if (n < cap) out[n] = (unsigned char)(acc >> bits);
+      ++n;
+    }
+  }
+  return n;
+}
+
+/** The data of the DataArray Name="name" of a .vtu string: a malloc'd copy
+ *  of its bytes (after the UInt64 byte count) and their number. */
+static unsigned char *vtu_array(const char *vtu, const char *name, size_t *bytes) {
+  char key[64];
+  snprintf(key, sizeof key, "Name=\"%s\"", name);
+  const char *at = strstr(vtu, key);
+  if (!at || !(at = strchr(at, '>'))) return NULL;
+  ++at;
+  const size_t cap = strlen(at);
+  unsigned char *raw = malloc(cap + 8);
+  const size_t n = b64_decode(at, raw, cap);
+  uint64_t len = 0;
+  memcpy(&len, raw, sizeof len);
+  if (n < 8 + len) { free(raw); return NULL; }
+  memmove(raw, raw + 8, len);
+  *bytes = len;
+  return raw;
+}
+
+/** Check the .pvtu output of an MPI run against the one-process .vtu files:
+ *  fields.pvd lists .pvtu files at the same steps, each names one piece per
+ *  rank, the pieces' elements add up to the mesh's, and c_1 at every node of
+ *  every piece (by node_id) equals the one-process value to 1e-9. */
+static void compare_fields(const char *ref, const char *par, int size) {
+  char path[2048];
+  snprintf(path, sizeof path, "%s/fields.pvd", ref);
+  char *pvd_ref = slurp(path);
+  snprintf(path, sizeof path, "%s/fields.pvd", par);
+  char *pvd_par = slurp(path);
+  CHECK(pvd_ref && pvd_par, "fields.pvd missing in %s or %s", ref, par);
+  if (!pvd_ref || !pvd_par) { free(pvd_ref); free(pvd_par); return; }
+  int files = 0, worst_elems = 0;
+  double worst_c = 0;
+  const char *pr = pvd_ref, *pp = pvd_par;
+  while ((pr = strstr(pr, "file=\"")) != NULL) {
+    int step_ref = -1, step_par = -1;
+    sscanf(pr, "file=\"fields_%d.vtu\"", &step_ref);
+    pp = pp ? strstr(pp, "file=\"") : NULL;
+    CHECK(pp != NULL, "fields.pvd of %s lists fewer files", par);
+    if (!pp) break;
+    char ext[8] = "";
+    sscanf(pp, "file=\"fields_%d.%4[a-z]\"", &step_par, ext);
+    CHECK(step_par == step_ref && strcmp(ext, "pvtu") == 0, "listed %s step %d vs step %d",
+          ext, step_par, step_ref);
+    ++pr;
+    ++pp;
+    snprintf(path, sizeof path, "%s/fields_%06d.vtu", ref, step_ref);
+    char *vref = slurp(path);
+    CHECK(vref != NULL, "cannot read %s", path);
+    if (!vref) break;
+    int ref_nodes = 0, ref_elems = 0;
+    sscanf(strstr(vref, "<Piece"), "<Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\"",
+           &ref_nodes, &ref_elems);
+    size_t nb = 0;
+    double *c_ref = (double *)vtu_array(vref, "c_1", &nb);
+    CHECK(c_ref && nb == sizeof(double) * (size_t)ref_nodes, "c_1 of %s", path);
+    snprintf(path, sizeof path, "%s/fields_%06d.pvtu", par, step_ref);
+    char *pvtu = slurp(path);
+    CHECK(pvtu != NULL, "cannot read %s", path);
+    int elems = 0;
+    for (int r = 0; r < size && pvtu && c_ref; ++r) {
+      char piece[64];
+      snprintf(piece, sizeof piece, "Source=\"fields_%06d_p%d.vtu\"", step_ref, r);
+      CHECK(strstr(pvtu, piece) != NULL, "%s does not name piece %d", path, r);
+      snprintf(path, sizeof path, "%s/fields_%06d_p%d.vtu", par, step_ref, r);
+      char *vp = slurp(path);
+      CHECK(vp != NULL, "cannot read %s", path);
+      if (!vp) continue;
+      int n_nodes = 0, n_elems = 0;
+      sscanf(strstr(vp, "<Piece"), "<Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\"",
+             &n_nodes, &n_elems);
+      elems += n_elems;
+      size_t bc = 0, bi = 0;
+      double *c = (double *)vtu_array(vp, "c_1", &bc);
+      int32_t *id = (int32_t *)vtu_array(vp, "node_id", &bi);
+      CHECK(c && id && bc == sizeof(double) * (size_t)n_nodes &&
+            bi == sizeof(int32_t) * (size_t)n_nodes, "arrays of %s", path);
+      for (int j = 0; c && id && j < n_nodes; ++j) {
+        CHECK(id[j] >= 0 && id[j] < ref_nodes, "%s: node_id %d", path, id[j]);
+        if (id[j] >= 0 && id[j] < ref_nodes) worst_c = fmax(worst_c, fabs(c[j] - c_ref[id[j]]));
+      }
+      free(c); free(id); free(vp);
+    }
+    CHECK(elems == ref_elems, "step %d: the pieces hold %d elements, the mesh %d", step_ref,
+          elems, ref_elems);
+    if (abs(elems - ref_elems) > worst_elems) worst_elems = abs(elems - ref_elems);
+    free(pvtu); free(c_ref); free(vref);
+    ++files;
+  }
+  printf("fields: %d .pvtu files of %d pieces; elements missing or doubled %d; largest "
+         "difference of c_1 from one process %.2e\n", files, size, worst_elems, worst_c);
+  CHECK(files >= 2, "only %d field files compared", files);
+  CHECK(worst_c <= 1e-9, "c_1 differs from one process by %.3g", worst_c);
+  free(pvd_ref); free(pvd_par);
+}
+
 static int cmd_steps(int argc, char **argv, int rank, int size) {
   if (argc < 2) {
     fprintf(stderr, "usage: mpi_compare steps LABEL SCENE [key=value]...\n");
@@ -186,6 +327,7 @@ static int cmd_steps(int argc, char **argv, int rank, int size) {
     printf("%d processes: %d steps, %.1f s\n", size, sum_par.steps, MPI_Wtime() - t0);
     CHECK(sum_ref.steps == sum_par.steps, "%d vs %d steps", sum_ref.steps, sum_par.steps);
     compare_runs(ref, par);
+    if (size > 1) compare_fields(ref, par, size);
   }
   sp_scene_destroy(&scene);
   return 0;

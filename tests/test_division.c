@@ -143,7 +143,7 @@ static double check_split(const sp_mesh *mesh, const double *w, double x, double
   sp_cell_obs before[2], after[3];
   CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, before));
   const double width = interface_width();
-  CHECK_OK(sp_division_split(mesh, layout, state, 0, &before[0], smooth, width, new_layout,
+  CHECK_OK(sp_division_split(mesh, layout, state, 0, &before[0], smooth, width, 0.0, new_layout,
                              new_state, 2));
   CHECK_OK(sp_cells_observe(mesh, new_layout, new_state, WEIGHT_THRESHOLD, after));
 
@@ -277,23 +277,23 @@ static void test_split_local_supports(void) {
   sp_cell_obs before[2], after[3];
   CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, before));
   for (int smooth = 0; smooth <= 1; ++smooth) {
-    CHECK_OK(sp_division_split(mesh, layout, state, 0, &before[0], smooth, interface_width(),
+    CHECK_OK(sp_division_split(mesh, layout, state, 0, &before[0], smooth, interface_width(), 0.0,
                                new_layout, new_state, 2));
     CHECK_OK(sp_cells_observe(mesh, new_layout, new_state, WEIGHT_THRESHOLD, after));
     const double rel = fabs(after[0].mass + after[2].mass - before[0].mass) / before[0].mass;
     CHECK(rel <= 1e-13, "local supports, smooth %d: relative mass change %.3g", smooth, rel);
     CHECK(after[1].mass == before[1].mass, "local supports: bystander mass changed");
     const int rc = sp_division_split(mesh, layout, state, 0, &before[0], smooth,
-                                     interface_width(), bad_layout, bad_state, 2);
+                                     interface_width(), 0.0, bad_layout, bad_state, 2);
     CHECK(rc == SP_ERR_INTERNAL, "child support too small, smooth %d: returned %d", smooth, rc);
     printf("  local supports, %s: mass conservation %.1e; too small a child support: "
            "\"%s\"\n", smooth ? "smooth" : "sharp", rel, sp_error_message());
     sp_error_clear();
   }
   /* a wrong child index or cell count is refused */
-  CHECK(sp_division_split(mesh, layout, state, 0, &before[0], 0, 0.0, new_layout, new_state,
+  CHECK(sp_division_split(mesh, layout, state, 0, &before[0], 0, 0.0, 0.0, new_layout, new_state,
                           1) == SP_ERR_INTERNAL, "child index 1 accepted");
-  CHECK(sp_division_split(mesh, layout, state, 0, &before[0], 1, 0.0, new_layout, new_state,
+  CHECK(sp_division_split(mesh, layout, state, 0, &before[0], 1, 0.0, 0.0, new_layout, new_state,
                           2) == SP_ERR_INTERNAL, "smoothed cut with width 0 accepted");
   sp_error_clear();
   free(mask);
@@ -454,10 +454,88 @@ static void test_max_cells(void) {
          sp_division_max_cells(ellipse, seed));
 }
 
+/** c = an egg: the union (max) of two tanh disks along the direction phi,
+ *  the larger at (x, y), on a background; mu = 0. */
+static void set_egg(const sp_mesh *mesh, const sp_layout *layout, double *state, double x,
+                    double y, double phi, double background) {
+  const double d = interface_width(), r1 = 0.1, r2 = 0.07, gap = 0.12;
+  const double x2 = x + gap * cos(phi), y2 = y + gap * sin(phi);
+  for (int i = 0; i < mesh->n_nodes; ++i) {
+    const int p = sp_layout_pair(layout, 0, i);
+    const double *X = mesh->xy + 2 * i;
+    const double d1 = hypot(X[0] - x, X[1] - y) - r1, d2 = hypot(X[0] - x2, X[1] - y2) - r2;
+    const double profile = 1.0 / (1.0 + exp(fmin(d1, d2) / d));
+    state[2 * p] = profile + (1.0 - profile) * background;
+    state[2 * p + 1] = 0.0;
+  }
+}
+
+/* division.line = equal_mass: the line moved along its normal halves an
+ * egg-shaped parent that the centre line splits unequally; the direction is
+ * unchanged, and a symmetric cell's line does not move. */
+static void test_equal_mass_line(void) {
+  sp_mesh *mesh;
+  sp_layout *layout, *new_layout;
+  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 160, 160, &mesh));
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 2, &new_layout));
+  double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
+  double *new_state = calloc(2 * (size_t)new_layout->n_pairs, sizeof(double));
+  const double width = interface_width();
+  printf("  equal-mass line | cut    | offset    | centre line: daughters off by | "
+         "equal mass: off by\n");
+  for (int egg = 0; egg <= 1; ++egg)
+    for (int smooth = 0; smooth <= 1; ++smooth) {
+      if (egg)
+        set_egg(mesh, layout, state, 0.42, 0.45, 0.7, 0.01);
+      else
+        set_ellipse(mesh, layout, state, 0, 0.5, 0.5, 0.12, 0.06, 0.3, 0.01);
+      sp_cell_obs before, after[2];
+      CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, &before));
+      double unequal[2], offset = 0;
+      for (int balanced = 0; balanced <= 1; ++balanced) {
+        if (balanced)
+          CHECK_OK(sp_division_balance_offset(mesh, layout, state, 0, &before, smooth, width,
+                                              &offset));
+        CHECK_OK(sp_division_split(mesh, layout, state, 0, &before, smooth, width,
+                                   balanced ? offset : 0.0, new_layout, new_state, 1));
+        CHECK_OK(sp_cells_observe(mesh, new_layout, new_state, WEIGHT_THRESHOLD, after));
+        const double total = after[0].mass + after[1].mass;
+        /* sums over 1e5 quadrature points of a domain-wide background */
+        CHECK(fabs(total - before.mass) <= 1e-11 * before.mass,
+              "egg %d smooth %d balanced %d: mass %.17g -> %.17g", egg, smooth, balanced,
+              before.mass, total);
+        unequal[balanced] = fabs(after[0].mass - after[1].mass) / (0.5 * total);
+      }
+      printf("  %-15s | %-6s | %+9.2e | %.2e | %.2e\n", egg ? "egg" : "ellipse",
+             smooth ? "smooth" : "sharp", offset, unequal[0], unequal[1]);
+      /* the sharp cut moves in steps of one node's share: h^2 / (area / 2)
+       * ~ 2e-3 here; the smoothed cut is continuous in the offset */
+      const double allowed = smooth ? 1e-10 : 3e-3;
+      CHECK(unequal[1] <= allowed, "egg %d smooth %d: equal-mass daughters differ by %.3g "
+            "(allowed %.1g)", egg, smooth, unequal[1], allowed);
+      if (egg) {
+        CHECK(unequal[0] >= 0.03, "egg smooth %d: the centre line splits it %.3g: the test "
+              "needs an unequal parent", smooth, unequal[0]);
+        CHECK(fabs(offset) > 0.1 * mesh->h && fabs(offset) < 0.1, "egg smooth %d: offset %g",
+              smooth, offset);
+      } else if (smooth) {
+        CHECK(fabs(offset) <= 1e-3 * mesh->h, "symmetric ellipse: the line moved by %g",
+              offset);
+      }
+    }
+  free(state);
+  free(new_state);
+  sp_layout_destroy(&layout);
+  sp_layout_destroy(&new_layout);
+  sp_mesh_destroy(&mesh);
+}
+
 int main(void) {
   test_axis_of_ellipses();
   test_split_conserves_and_halves();
   test_split_local_supports();
+  test_equal_mass_line();
   test_age_criterion();
   test_mass_criterion();
   test_birth_records();
