@@ -55,12 +55,6 @@ run() {
     "$dir/log" | tr '\n' ' '
   local unknowns
   unknowns=$(sed -n 's/.*at most \([0-9]*\) unknowns.*/\1/p' "$dir/log")
-  if [ -z "$unknowns" ]; then
-    local nodes cells
-    nodes=$(grep -o 'NumberOfPoints="[0-9]*"' "$(ls "$dir"/out/fields_*.vtu | tail -1)" | head -1 | tr -dc 0-9)
-    cells=$(tail -1 "$dir/out/energy.csv" | cut -d, -f5)
-    unknowns=$((2 * cells * nodes))
-  fi
   local retries
   retries=$(sed -n 's/^softpack: .* steps to .* (\([0-9]*\) failed attempts.*/\1/p' "$dir/log")
   echo "$mem $unknowns $load $retries"

@@ -69,6 +69,8 @@ static int cmd_run(int argc, char **argv, int rank) {
     printf("softpack: local supports: %d changes (%.1f s), largest relative mass change restored "
            "%.2e, at most %ld unknowns\n",
            sum.layout_changes, sum.t_layout, sum.support_mass_correction, sum.unknowns_max);
+  else if (rc == SP_OK && rank == 0)
+    printf("softpack: at most %ld unknowns per step\n", sum.unknowns_max);
   if (rc == SP_OK && rank == 0)
     printf("softpack: %d steps to t = %.6g (%d failed attempts retried, %d of them for an "
            "energy rise; smallest dt %.3g), "

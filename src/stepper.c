@@ -107,7 +107,8 @@ static void core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
 
 /** Energy and observables rows of the current state (run->obs must be the
  *  observables of run->state: every change of the state refreshes them). */
-static int record_energy(sp_run *run, int step, double t, double dt, int its) {
+static int record_energy(sp_run *run, int step, double t, double dt, int its,
+                         const sp_step_seconds *seconds) {
   sp_energy_parts parts;
   if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
     return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
@@ -127,7 +128,8 @@ static int record_energy(sp_run *run, int step, double t, double dt, int its) {
   run->energy_t[run->n_energy] = t;
   run->energy_total[run->n_energy++] = total;
   if (run->rank != 0) return SP_OK;
-  SP_CALL(sp_output_energy(run->output, step, t, dt, its, run->layout->n_cells, &parts, shape));
+  SP_CALL(sp_output_energy(run->output, step, t, dt, its, run->layout->n_cells, &parts, shape,
+                           seconds));
   SP_CALL(sp_output_cells(run->output, step, t, run->layout->n_cells, run->obs));
   return SP_OK;
 }
@@ -345,14 +347,17 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   int since_division = -1; /* steps since the last division; -1: none yet */
   double *core_mass_old = NULL;
   sum->dt_smallest = tc->dt;
-  SP_CALL(record_energy(run, 0, t, 0.0, 0));
+  SP_CALL(record_energy(run, 0, t, 0.0, 0, NULL));
   SP_CALL(write_snapshot(run, 0, t));
   const double t_tol = 1e-12 * tc->t_end;
   /* the shape penalty's per-cell coefficients, refreshed before each step */
   const int shape_on = run->scene->shape.delta1 > 0 || run->scene->shape.delta2 > 0;
   sp_shape_coef *shape_coef = NULL;
+  sp_step_seconds seconds = {0, 0, 0, 0}; /* of the step being attempted */
+  double step_start = -1;
   int rc = SP_OK;
   while (rc == SP_OK && t < tc->t_end - t_tol && step < tc->max_steps) {
+    if (step_start < 0) step_start = wall_clock(); /* the first attempt of a step */
     const int n_cells = run->layout->n_cells;
     const size_t n_values = 2 * (size_t)run->layout->n_pairs;
     if ((long)n_values > sum->unknowns_max) sum->unknowns_max = (long)n_values;
@@ -385,6 +390,9 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     sum->t_assembly += report.t_assembly;
     sum->t_factor += report.t_factor;
     sum->t_solve += report.t_solve;
+    seconds.assembly += report.t_assembly;
+    seconds.factorisation += report.t_factor;
+    seconds.solves += report.t_solve;
     if (solved > 1) {
       rc = sp_error_set(SP_ERR_SOLVER, "step %d at t = %g: %s", step + 1, t,
                         sp_solver_last_error(run->solver));
@@ -457,7 +465,10 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       free(mass);
       if (rc != SP_OK) break;
     }
-    rc = record_energy(run, step, t, dt_try, report.newton_its);
+    seconds.step = wall_clock() - step_start;
+    rc = record_energy(run, step, t, dt_try, report.newton_its, &seconds);
+    seconds = (sp_step_seconds){0, 0, 0, 0};
+    step_start = -1;
     if (rc != SP_OK) break;
     const int last = !(t < tc->t_end - t_tol && step < tc->max_steps);
     if (step % run->scene->output.every == 0 || last || n_divided) rc = write_snapshot(run, step, t);

@@ -30,6 +30,7 @@
 
 #include "fixtures.h"
 #include "scene.h"
+#include "vtu_read.h"
 
 /* ---------- CSV files ---------- */
 
@@ -163,67 +164,6 @@ static void compare_runs(const char *ref, const char *par) {
   free(er.v); free(ep.v); free(cr.v); free(cp.v); free(dr.v); free(dp.v);
 }
 
-/* ---------- .vtu files (inline base64, UInt64 headers, as output.c writes) ---------- */
-
-/** The whole file as a string (NULL if unreadable). */
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  const long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  if (s && fread(s, 1, (size_t)n, f) != (size_t)n) { free(s); s = NULL; }
-  if (s) s[n] = 0;
-  fclose(f);
-  return s;
-}
-
-static int b64_value(char c) {
-  if (c >= 'A' && c <= 'Z') return c - 'A';
-  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-  if (c >= '0' && c <= '9') return c - '0' + 52;
-  return c == '+' ? 62 : c == '/' ? 63 : -1;
-}
-
-/** Decode base64 from s up to the next '<' into out (at most cap bytes). */
-static size_t b64_decode(const char *s, unsigned char *out, size_t cap) {
-  size_t n = 0;
-  unsigned acc = 0;
-  int bits = 0;
-  for (; *s && *s != '<'; ++s) {
-    const int v = b64_value(*s);
-    if (v < 0) continue; /* whitespace, '=' padding */
-    acc = (acc << 6) | (unsigned)v;
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      if (n < cap) out[n] = (unsigned char)(acc >> bits);
-      ++n;
-    }
-  }
-  return n;
-}
-
-/** The data of the DataArray Name="name" of a .vtu string: a malloc'd copy
- *  of its bytes (after the UInt64 byte count) and their number. */
-static unsigned char *vtu_array(const char *vtu, const char *name, size_t *bytes) {
-  char key[64];
-  snprintf(key, sizeof key, "Name=\"%s\"", name);
-  const char *at = strstr(vtu, key);
-  if (!at || !(at = strchr(at, '>'))) return NULL;
-  ++at;
-  const size_t cap = strlen(at);
-  unsigned char *raw = malloc(cap + 8);
-  const size_t n = b64_decode(at, raw, cap);
-  uint64_t len = 0;
-  memcpy(&len, raw, sizeof len);
-  if (n < 8 + len) { free(raw); return NULL; }
-  memmove(raw, raw + 8, len);
-  *bytes = len;
-  return raw;
-}
-
 /** Check the .pvtu output of an MPI run against the one-process .vtu files:
  *  fields.pvd lists .pvtu files at the same steps, each names one piece per
  *  rank, the pieces' elements add up to the mesh's, and c_1 at every node of
@@ -231,9 +171,9 @@ static unsigned char *vtu_array(const char *vtu, const char *name, size_t *bytes
 static void compare_fields(const char *ref, const char *par, int size) {
   char path[2048];
   snprintf(path, sizeof path, "%s/fields.pvd", ref);
-  char *pvd_ref = slurp(path);
+  char *pvd_ref = slurp(path, NULL);
   snprintf(path, sizeof path, "%s/fields.pvd", par);
-  char *pvd_par = slurp(path);
+  char *pvd_par = slurp(path, NULL);
   CHECK(pvd_ref && pvd_par, "fields.pvd missing in %s or %s", ref, par);
   if (!pvd_ref || !pvd_par) { free(pvd_ref); free(pvd_par); return; }
   int files = 0, worst_elems = 0;
@@ -252,17 +192,17 @@ static void compare_fields(const char *ref, const char *par, int size) {
     ++pr;
     ++pp;
     snprintf(path, sizeof path, "%s/fields_%06d.vtu", ref, step_ref);
-    char *vref = slurp(path);
+    char *vref = slurp(path, NULL);
     CHECK(vref != NULL, "cannot read %s", path);
     if (!vref) break;
     int ref_nodes = 0, ref_elems = 0;
     sscanf(strstr(vref, "<Piece"), "<Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\"",
            &ref_nodes, &ref_elems);
     size_t nb = 0;
-    double *c_ref = (double *)vtu_array(vref, "c_1", &nb);
+    double *c_ref = (double *)vtu_array_data(vref, "c_1", &nb);
     CHECK(c_ref && nb == sizeof(double) * (size_t)ref_nodes, "c_1 of %s", path);
     snprintf(path, sizeof path, "%s/fields_%06d.pvtu", par, step_ref);
-    char *pvtu = slurp(path);
+    char *pvtu = slurp(path, NULL);
     CHECK(pvtu != NULL, "cannot read %s", path);
     int elems = 0;
     for (int r = 0; r < size && pvtu && c_ref; ++r) {
@@ -270,7 +210,7 @@ static void compare_fields(const char *ref, const char *par, int size) {
       snprintf(piece, sizeof piece, "Source=\"fields_%06d_p%d.vtu\"", step_ref, r);
       CHECK(strstr(pvtu, piece) != NULL, "%s does not name piece %d", path, r);
       snprintf(path, sizeof path, "%s/fields_%06d_p%d.vtu", par, step_ref, r);
-      char *vp = slurp(path);
+      char *vp = slurp(path, NULL);
       CHECK(vp != NULL, "cannot read %s", path);
       if (!vp) continue;
       int n_nodes = 0, n_elems = 0;
@@ -278,8 +218,8 @@ static void compare_fields(const char *ref, const char *par, int size) {
              &n_nodes, &n_elems);
       elems += n_elems;
       size_t bc = 0, bi = 0;
-      double *c = (double *)vtu_array(vp, "c_1", &bc);
-      int32_t *id = (int32_t *)vtu_array(vp, "node_id", &bi);
+      double *c = (double *)vtu_array_data(vp, "c_1", &bc);
+      int32_t *id = (int32_t *)vtu_array_data(vp, "node_id", &bi);
       CHECK(c && id && bc == sizeof(double) * (size_t)n_nodes &&
             bi == sizeof(int32_t) * (size_t)n_nodes, "arrays of %s", path);
       for (int j = 0; c && id && j < n_nodes; ++j) {

@@ -16,6 +16,7 @@
 #include "layout.h"
 #include "output.h"
 #include "render.h"
+#include "vtu_read.h"
 
 #define DIR "test_output_tmp/run/a"
 #define NX 6
@@ -25,83 +26,24 @@
 
 /* ---- helpers ----------------------------------------------------------- */
 
-static char *slurp(const char *path, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *s = malloc((size_t)n + 1);
-  size_t got = fread(s, 1, (size_t)n, f);
-  s[got] = '\0';
-  fclose(f);
-  if (len) *len = got;
-  return s;
-}
-
 static int exists(const char *path) {
   FILE *f = fopen(path, "rb");
   if (f) fclose(f);
   return f != NULL;
 }
 
-static int b64_value(char c) {
-  if (c >= 'A' && c <= 'Z') return c - 'A';
-  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-  if (c >= '0' && c <= '9') return c - '0' + 52;
-  if (c == '+') return 62;
-  if (c == '/') return 63;
-  return -1;
-}
-
-/* Decode base64 from s up to '<'. A padded quad may also occur mid-stream
- * (some writers encode the header separately), so accept that too.
- * Returns the byte count. */
-static size_t b64_decode(const char *s, unsigned char *out, size_t cap) {
-  size_t n = 0;
-  char q[4];
-  int nq = 0;
-  for (; *s && *s != '<'; ++s) {
-    if (*s == ' ' || *s == '\n' || *s == '\r' || *s == '\t') continue;
-    q[nq++] = *s;
-    if (nq < 4) continue;
-    nq = 0;
-    int pad = (q[2] == '=') + (q[3] == '=');
-    unsigned v = 0;
-    for (int i = 0; i < 4; ++i)
-      v = v << 6 | (unsigned)(q[i] == '=' ? 0 : b64_value(q[i]));
-    unsigned char b[3] = {(unsigned char)(v >> 16), (unsigned char)(v >> 8),
-                          (unsigned char)v};
-    for (int i = 0; i < 3 - pad && n < cap; ++i) out[n++] = b[i];
-  }
-  return n;
-}
-
-/* The data of DataArray @p name in @p xml (after its UInt64 byte-count
- * header, which must match @p expect_bytes); malloc'd, NULL if absent. */
+/* The data of DataArray @p name in @p xml, which must hold @p expect_bytes;
+ * malloc'd, NULL if absent. */
 static unsigned char *vtu_array(const char *xml, const char *name,
                                 size_t expect_bytes) {
-  char key[64];
-  snprintf(key, sizeof key, "Name=\"%s\"", name);
-  const char *p = strstr(xml, key);
-  if (!p) return NULL;
-  p = strchr(p, '>');
-  if (!p) return NULL;
-  size_t cap = 8 + expect_bytes + 16;
-  unsigned char *raw = malloc(cap);
-  size_t n = b64_decode(p + 1, raw, cap);
-  uint64_t header = 0;
-  if (n >= 8) memcpy(&header, raw, 8);
-  CHECK(n == 8 + expect_bytes && header == expect_bytes,
-        "array %s: %zu bytes decoded, header %llu, expected %zu + 8", name, n,
-        (unsigned long long)header, expect_bytes);
-  if (n != 8 + expect_bytes) {
-    free(raw);
+  size_t n = 0;
+  unsigned char *data = vtu_array_data(xml, name, &n);
+  CHECK(data && n == expect_bytes, "array %s: %zu bytes decoded, expected %zu", name,
+        data ? n : 0, expect_bytes);
+  if (data && n != expect_bytes) {
+    free(data);
     return NULL;
   }
-  unsigned char *data = malloc(expect_bytes + 1);
-  memcpy(data, raw + 8, expect_bytes);
-  free(raw);
   return data;
 }
 
@@ -215,9 +157,10 @@ int main(void) {
                                     {3.14159265358979, 2.0 / 7.0, 0, 0},
                                     {1e17 + 3, -0.0, 5e-324, 1.1}};
   const double shape[3] = {0.0, 1.0 / 9.0, 123.456};
+  const sp_step_seconds seconds = {2.5, 0.25, 2.0, 0.125}; /* exact in %.4g */
   for (int r = 0; r < 3; ++r)
     CHECK_OK(sp_output_energy(out, r * 10, tv[r], 2e-4 / 3.0, r + 2, 2,
-                              &parts[r], shape[r]));
+                              &parts[r], shape[r], r == 1 ? &seconds : NULL));
   sp_cell_obs obs[2];
   memset(obs, 0, sizeof obs);
   obs[0].mass = 0.1 / 3.0, obs[0].xc = 0.25, obs[0].angle = -1.0 / 7.0;
@@ -234,8 +177,10 @@ int main(void) {
     char *csv = slurp(DIR "/energy.csv", NULL);
     CHECK(csv != NULL, "energy.csv missing");
     if (csv) {
-      CHECK(strncmp(csv, "step,t,dt,newton_its,n_cells,energy,bulk,gradient,"
-                         "repulsion,buffer,shape\n", 71) == 0,
+      static const char header[] = "step,t,dt,newton_its,n_cells,energy,bulk,gradient,"
+                                   "repulsion,buffer,shape,seconds,assembly_s,"
+                                   "factorisation_s,solves_s\n";
+      CHECK(strncmp(csv, header, strlen(header)) == 0,
             "energy.csv header: %.80s", csv);
       int rows = 0;
       char *line = strchr(csv, '\n') + 1;
@@ -248,9 +193,13 @@ int main(void) {
         double dt = strtod(end + 1, &end);
         ints[0] = strtol(end + 1, &end, 10);
         ints[1] = strtol(end + 1, &end, 10);
-        for (int j = 0; j < 6; ++j) v[j] = strtod(end + 1, &end);
+        for (int j = 0; j < 10; ++j) v[j] = strtod(end + 1, &end);
         CHECK(*end == '\n', "row %d ends with '%c'", rows, *end);
         if (rows < 3) {
+          const sp_step_seconds w = rows == 1 ? seconds : (sp_step_seconds){0, 0, 0, 0};
+          CHECK(v[6] == w.step && v[7] == w.assembly && v[8] == w.factorisation &&
+                    v[9] == w.solves,
+                "row %d seconds %g %g %g %g", rows, v[6], v[7], v[8], v[9]);
           const sp_energy_parts *p = &parts[rows];
           double total = p->bulk + p->gradient + p->repulsion + p->buffer +
                          shape[rows];
