@@ -1,19 +1,21 @@
 #!/usr/bin/env bash
 # MPI runs against one process (issue 6): seconds per Newton iteration and
-# per step, split into assembly, factorisation and solves, speed-up, and peak
-# memory (RSS) of every rank, for each direct solver and process count.
+# per step, split into assembly, factorisation, solves and the rest (the
+# state's all-gather and the reductions of observables and energies, i.e.
+# the communication, plus output and the C core's per-step work), speed-up,
+# and peak memory (RSS) of every rank, for each direct solver and process
+# count.
 # Prints the tables of docs/parallel.md.
 #
 #   bench/bench_parallel.sh [case ...]
 #   cases: r6    inputs/default.yaml (3 cells, full supports) on the ellipse
 #                refined 6 times, 4 steps of dt = 2e-6
-#          r7    the same refined 7 times, 2 steps (serial SuperLU left out:
+#          r7    the same refined 7 times, 1 step (serial SuperLU left out:
 #                tens of minutes)
 #          paper16  inputs/paper/constant_volume_16.yaml (local supports):
 #                the steps between t = 0.0124 (just after the third division
-#                round, 4 -> 8 cells, at t = 0.01239) and t = 0.0134; the
-#                program cannot restart, so each configuration runs to both
-#                times and the table shows the difference
+#                round, 4 -> 8 cells, at t = 0.01239) and t = 0.0134, summed
+#                from the per-step seconds of energy.csv
 #          r4    as r6 on the default mesh (refined 4 times): a quick check
 #   default: r6 r7 paper16
 # Environment: NPS (default "1 2"), SOLVERS (default "superlu superlu_dist
@@ -51,8 +53,13 @@ run() {
       echo "FAILED: np $np $lin $tag (log: $dir/log)" >&2; cat "$dir/log" >&2; return 1; }
   local mem="" r
   for ((r = 0; r < np; ++r)); do mem+="${mem:+/}$(( $(cat "$dir/mem.$r") / 1024 ))"; done
-  sed -n 's/^softpack: \([0-9]*\) steps .* \([0-9]*\) Newton iterations, \([0-9.]*\) s (assembly \([0-9.]*\), factorisation \([0-9.]*\), solves \([0-9.]*\)).*/\1 \2 \3 \4 \5 \6/p' \
-    "$dir/log" | tr '\n' ' '
+  if [ -n "${WINDOW_T0:-}" ]; then # the steps after t = WINDOW_T0, from energy.csv
+    awk -F, -v t0="$WINDOW_T0" 'NR > 1 && $2 > t0 { ++n; its += $4; s += $12; a += $13; f += $14; v += $15 }
+      END { printf "%d %d %.3f %.3f %.3f %.3f ", n, its, s, a, f, v }' "$dir/out/energy.csv"
+  else
+    sed -n 's/^softpack: \([0-9]*\) steps .* \([0-9]*\) Newton iterations, \([0-9.]*\) s (assembly \([0-9.]*\), factorisation \([0-9.]*\), solves \([0-9.]*\)).*/\1 \2 \3 \4 \5 \6/p' \
+      "$dir/log" | tr '\n' ' '
+  fi
   local unknowns
   unknowns=$(sed -n 's/.*at most \([0-9]*\) unknowns.*/\1/p' "$dir/log")
   local retries
@@ -64,8 +71,8 @@ header() {
   echo
   echo "### $1"
   echo
-  echo "| solver | np | unknowns | steps | Newton its | s/step | s/iteration | assembly/it | factorisation/it | solves/it | speed-up | peak MB per rank | load before | retries |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| solver | np | unknowns | steps | Newton its | s/step | s/iteration | assembly/it | factorisation/it | solves/it | rest/it | speed-up | peak MB per rank | load before | retries |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 }
 
 # row LIN NP "steps its total asm fac sol mem unknowns" BASE_TOTAL
@@ -74,8 +81,8 @@ row() {
   read -r steps its total as fa so mem unknowns load retries <<< "$3"
   awk -v lin="$lin" -v np="$np" -v steps="$steps" -v its="$its" -v total="$total" -v as="$as" \
       -v fa="$fa" -v so="$so" -v mem="$mem" -v base="$base" -v unk="$unknowns" -v load="$load" -v retries="$retries" 'BEGIN {
-    printf "| %s | %d | %s | %d | %d | %.2f | %.2f | %.3f | %.3f | %.3f | %s | %s | %s | %s |\n", lin, np, unk, steps, its,
-      total / steps, total / its, as / its, fa / its, so / its,
+    printf "| %s | %d | %s | %d | %d | %.2f | %.2f | %.3f | %.3f | %.3f | %.3f | %s | %s | %s | %s |\n", lin, np, unk, steps, its,
+      total / steps, total / its, as / its, fa / its, so / its, (total - as - fa - so) / its,
       (base > 0 ? sprintf("%.2f", base / total) : "-"), mem, load, retries }'
 }
 
@@ -102,22 +109,11 @@ for c in "${cases[@]}"; do
           inputs/default.yaml --set time.dt=2e-6 --set time.t_end=8e-6 ;;
     r6) table "Ellipse refined 6 times, 3 cells, full supports (4 steps of dt = 2e-6)" r6 "" \
           inputs/default.yaml --set mesh.refinements=6 --set time.dt=2e-6 --set time.t_end=8e-6 ;;
-    r7) table "Ellipse refined 7 times, 3 cells, full supports (2 steps of dt = 2e-6)" r7 superlu \
-          inputs/default.yaml --set mesh.refinements=7 --set time.dt=2e-6 --set time.t_end=4e-6 ;;
-    paper16)
-      header "Paper run 1 (16 cells, local supports): the steps from t = 0.0124 to 0.0134 (8 cells)"
-      for lin in "${solvers[@]}"; do
-        base=0
-        for np in "${nps[@]}"; do
-          a=$(run "$np" "$lin" p16a inputs/paper/constant_volume_16.yaml --set time.t_end=0.0124)
-          b=$(run "$np" "$lin" p16b inputs/paper/constant_volume_16.yaml --set time.t_end=0.0134)
-          # the window = second run - first run (memory: the second run's)
-          d=$(paste -d' ' <(echo "$a") <(echo "$b") | awk '{ printf "%d %d %.3f %.3f %.3f %.3f %s %s %s %d\n",
-                $11 - $1, $12 - $2, $13 - $3, $14 - $4, $15 - $5, $16 - $6, $17, $18, $19, $20 - $10 }')
-          [ "$np" = 1 ] && base=$(echo "$d" | cut -d' ' -f3)
-          row "$lin" "$np" "$d" "$base"
-        done
-      done ;;
+    r7) table "Ellipse refined 7 times, 3 cells, full supports (1 step of dt = 2e-6)" r7 superlu \
+          inputs/default.yaml --set mesh.refinements=7 --set time.dt=2e-6 --set time.t_end=2e-6 ;;
+    paper16) # the window's steps from energy.csv's per-step seconds
+      WINDOW_T0=0.0124 table "Paper run 1 (16 cells, local supports): the steps from t = 0.0124 to 0.0134 (8 cells)" \
+        p16 "" inputs/paper/constant_volume_16.yaml --set time.t_end=0.0134 ;;
     *) echo "unknown case $c" >&2; exit 2 ;;
   esac
 done

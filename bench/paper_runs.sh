@@ -3,7 +3,9 @@
 # table of docs/paper-runs.md; copies the pictures at each stage (the last
 # picture with N cells, for every N reached) and the energy curve to
 # docs/img/paper/<run>/.
-#   bench/paper_runs.sh [--reuse] [run ...]   runs: constant_volume_16 growth_12 embryo_8
+#   bench/paper_runs.sh [--reuse] [run ...]
+#   runs: constant_volume_16 growth_12 embryo_8 growth_shape_12 (issue 4's run 4;
+#   with run 2 it prints the comparison of the two)
 # --reuse: do not rerun a run whose out/paper/<run>/ and out/paper/<run>.log
 # exist (tables and pictures from that earlier run).
 set -euo pipefail
@@ -11,7 +13,7 @@ cd "$(dirname "$0")/.."
 reuse=0
 [ "${1:-}" = "--reuse" ] && { reuse=1; shift; }
 runs=("$@")
-[ ${#runs[@]} -eq 0 ] && runs=(constant_volume_16 growth_12 embryo_8)
+[ ${#runs[@]} -eq 0 ] && runs=(constant_volume_16 growth_12 embryo_8 growth_shape_12)
 export OMP_NUM_THREADS=1
 for run in "${runs[@]}"; do
   out=out/paper/$run
@@ -60,3 +62,18 @@ for run in "${runs[@]}"; do
   done
   echo "   pictures: $(ls "$img" | tr '\n' ' ')"
 done
+
+# Run 4 against run 2 (issue 4): the energy and the packing at the end
+if [ -f out/paper/growth_12/cells.csv ] && [ -f out/paper/growth_shape_12/cells.csv ]; then
+  echo "== run 4 (shape penalty) against run 2"
+  echo "   | run | cells | final energy (shape part) | largest energy | mean sqrt(I1/I2) | largest sqrt(I1/I2) |"
+  for run in growth_12 growth_shape_12; do
+    out=out/paper/$run
+    e=$(awk -F, 'NR > 1 { last = $6; shape = $11; if ($6 > peak) peak = $6 } END { printf "%.4g (%.3g) | %.4g", last, shape, peak }' "$out/energy.csv")
+    a=$(awk -F, 'NR > 1 { last = $1; if ($8 > 0) r[$1, $3] = sqrt($7 / $8); n[$1] = $3 > n[$1] ? $3 : n[$1] }
+      END { s = 0; m = 0; for (k = 1; k <= n[last]; ++k) { s += r[last, k]; if (r[last, k] > m) m = r[last, k] }
+            printf "%d | %.3f | %.3f", n[last], s / n[last], m }' "$out/cells.csv")
+    cells=${a%% *}
+    echo "   | $run | $cells | $e | ${a#* | } |"
+  done
+fi

@@ -21,6 +21,27 @@ void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
   v2[1] = v1[0];
 }
 
+int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, double *w) {
+  SP_CHECK(k >= 0 && k < layout->n_cells && layout->n_nodes == mesh->n_nodes, SP_ERR_INTERNAL,
+           "node weights: cell %d of %d, %d nodes in the layout, %d in the mesh", k,
+           layout->n_cells, layout->n_nodes, mesh->n_nodes);
+  for (int i = 0; i < mesh->n_nodes; ++i) w[i] = 0.0;
+  for (int e = 0; e < mesh->n_elems; ++e) {
+    const int *nodes = mesh->elem + 4 * e;
+    int whole = 1;
+    for (int b = 0; b < 4 && whole; ++b) whole = sp_layout_pair(layout, k, nodes[b]) >= 0;
+    if (!whole) continue;
+    double xy[4][2];
+    sp_mesh_elem_xy(mesh, e, xy);
+    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+      double N[4], dNdx[4][2], x[2], wq;
+      sp_q1_point(xy, q, N, dNdx, x, &wq);
+      for (int b = 0; b < 4; ++b) w[nodes[b]] += wq * N[b];
+    }
+  }
+  return SP_OK;
+}
+
 int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
                      const double *state, double weight_threshold,
                      sp_cell_obs *obs) {

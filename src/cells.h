@@ -39,6 +39,16 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
                      const double *state, double weight_threshold,
                      sp_cell_obs *obs);
 
+/**
+ * @brief Node weights of one cell: w[i] = int phi_i over the elements of
+ *        cell k's domain (all four nodes in its support, the solver's rule),
+ *        0 elsewhere. The mass is then sum_i w_i c_i exactly (the Q1 shape
+ *        functions sum to one), so a nodal change of c_k by d_i changes the
+ *        mass by sum_i w_i d_i.
+ * @param[out] w n_nodes values
+ */
+int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, double *w);
+
 /** @brief Principal moments and unit eigenvectors of a symmetric 2x2
  *         tensor, larger first (v1 is the larger moment's). */
 void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,

@@ -4,7 +4,6 @@
 #include <stdlib.h>
 
 #include "error.h"
-#include "q1.h"
 
 /** A node within this fraction of the mesh size h of the division line is
  *  "on" it for the sharp cut (round-off in the centre of mass is ~1e-16). */
@@ -185,18 +184,10 @@ int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
   double *buffer; /* one block: nothing leaks on the error return */
   SP_ALLOC(buffer, 4 * nn);
   double *w_node = buffer, *w = buffer + nn, *c = buffer + 2 * nn, *sd = buffer + 3 * nn;
-  for (int e = 0; e < mesh->n_elems; ++e) {
-    const int *nodes = mesh->elem + 4 * e;
-    int whole = 1;
-    for (int b = 0; b < 4 && whole; ++b) whole = sp_layout_pair(layout, parent, nodes[b]) >= 0;
-    if (!whole) continue;
-    double xy[4][2];
-    sp_mesh_elem_xy(mesh, e, xy);
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      double N[4], dNdx[4][2], x[2], w;
-      sp_q1_point(xy, q, N, dNdx, x, &w);
-      for (int b = 0; b < 4; ++b) w_node[nodes[b]] += w * N[b];
-    }
+  const int rc = sp_cells_node_weights(mesh, layout, parent, w_node);
+  if (rc != SP_OK) {
+    free(buffer);
+    return rc;
   }
   /* the parent's nodes: weight, value, signed distance from the centre line */
   int n = 0;

@@ -21,18 +21,21 @@ typedef struct sp_output_s *sp_output;
 /** @brief Create @p dir (and parents) and start the CSV logs with headers. */
 int sp_output_open(const char *dir, sp_output *out);
 
-/** Wall-clock seconds of one accepted step (rank 0's clock): the whole step
- *  (every attempt, divisions, support changes) and the solver's phases. */
+/** What one accepted step cost, in wall-clock seconds of rank 0: the whole
+ *  step (every attempt, divisions, support changes), the solver's phases
+ *  and the support change (local supports), and whether one happened. */
 typedef struct {
-  double step, assembly, factorisation, solves;
-} sp_step_seconds;
+  double step, assembly, factorisation, solves, supports;
+  int support_changed;
+} sp_step_costs;
 
 /** @brief Append one row to energy.csv:
  *  step,t,dt,newton_its,n_cells,energy,bulk,gradient,repulsion,buffer,shape,
- *  seconds,assembly_s,factorisation_s,solves_s (@p seconds NULL: zeros) */
+ *  seconds,assembly_s,factorisation_s,solves_s,supports_s,support_changed
+ *  (@p seconds NULL: zeros) */
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,
-                     double shape, const sp_step_seconds *seconds);
+                     double shape, const sp_step_costs *seconds);
 
 /** @brief Append one row per cell to cells.csv:
  *  step,t,cell,mass,xc,yc,I1,I2,angle,core_mass (cells numbered from 1;

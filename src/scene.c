@@ -134,6 +134,8 @@ static const cyaml_strval_t sp_cut_words[] = {
     {"sharp", SP_CUT_SHARP}, {"smooth", SP_CUT_SMOOTH}};
 static const cyaml_strval_t sp_line_words[] = {
     {"centre", SP_LINE_CENTRE}, {"equal_mass", SP_LINE_EQUAL_MASS}};
+static const cyaml_strval_t sp_shrink_words[] = {
+    {"divisions", SP_SHRINK_DIVISIONS}, {"always", SP_SHRINK_ALWAYS}};
 static const cyaml_strval_t sp_support_words[] = {
     {"auto", SP_SUPPORT_AUTO}, {"full", SP_SUPPORT_FULL}, {"local", SP_SUPPORT_LOCAL}};
 /* The YAML 1.1 booleans; the first word of each value is the one printed. */
@@ -249,10 +251,6 @@ static const sp_key sp_keys[] = {
     KEY_INT(SP_SEC_TIME, "max_retries", time.max_retries, 30, AT_LEAST(1),
             AT_MOST(1000), "-",
             "failed attempts of one step before the run stops"),
-    KEY_BOOL(SP_SEC_TIME, "energy_guard", time.energy_guard, 0, "-",
-             "reject a step whose energy rises while no source, division or "
-             "shape term acts (backward Euler is energy-stable only for small "
-             "dt) and retry it with dt x shrink"),
     /* noise */
     KEY_FLOAT(SP_SEC_NOISE, "background", noise.background, 0.0,
               AT_LEAST(0.0), AT_MOST(1.0), "-",
@@ -349,6 +347,12 @@ static const sp_key sp_keys[] = {
               "of a support's edge"),
     KEY_FLOAT(SP_SEC_LAYOUT, "band", layout.band, 4.0, ABOVE(0.0), UNBOUNDED,
               "d", "local: width of that band in interface widths (< margin)"),
+    KEY_ENUM(SP_SEC_LAYOUT, "shrink", layout.shrink, SP_SHRINK_DIVISIONS, sp_shrink_words,
+             "-",
+             "local: supports grow whenever a cell needs it; they shrink only "
+             "for the two daughters of a division (divisions), or at every "
+             "support change (always: fewer unknowns, but dropping and "
+             "restoring far-field mass raises the energy)"),
     /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
      * in E L^2, so delta is in E / L^6 */
     KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),

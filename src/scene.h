@@ -55,8 +55,6 @@ typedef struct {
   double grow;      /**< dt factor after grow_after successes (> 1) */
   int grow_after;   /**< consecutive successes before dt grows */
   int max_retries;  /**< failed attempts of one step before the run stops */
-  int energy_guard; /**< reject (and retry with a smaller dt) a step whose
-                         energy rises although nothing injects energy */
 } sp_scene_time;
 
 /** One initial cell. */
@@ -121,6 +119,8 @@ typedef struct {
 } sp_scene_source;
 
 typedef enum { SP_SUPPORT_AUTO = 0, SP_SUPPORT_FULL = 1, SP_SUPPORT_LOCAL = 2 } sp_support_kind;
+/** When a local support may shrink (it may always grow). */
+typedef enum { SP_SHRINK_DIVISIONS = 0, SP_SHRINK_ALWAYS = 1 } sp_shrink_kind;
 
 /** layout: where each cell's field lives. */
 typedef struct {
@@ -129,6 +129,8 @@ typedef struct {
   double core_threshold;   /**< local: the core is c_k >= this */
   double grow_threshold;   /**< local: grow when c_k >= this ... */
   double band;             /**< ... within this many widths of the edge */
+  sp_shrink_kind shrink;   /**< local: shrink only the supports of dividing
+                                cells, or at every support change */
 } sp_scene_layout;
 
 /** shape: the shape penalty on principal moments (MODEL.md, paper sec. 3). */

@@ -89,6 +89,8 @@ typedef struct {
   sp_cell_birth *birth;
   int *source_on;
   int *division_skipped; /* due but no field left: reported once */
+  unsigned char *divided_now; /* parent or daughter of a division this step:
+                                 its support may shrink (layout.shrink) */
   double *source;        /* per pair, from c^n */
   int n_max;             /* N_max */
   sp_support support;    /* local supports (NULL: full) */
@@ -108,7 +110,7 @@ static void core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
 /** Energy and observables rows of the current state (run->obs must be the
  *  observables of run->state: every change of the state refreshes them). */
 static int record_energy(sp_run *run, int step, double t, double dt, int its,
-                         const sp_step_seconds *seconds) {
+                         const sp_step_costs *seconds) {
   sp_energy_parts parts;
   if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
     return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
@@ -170,6 +172,15 @@ static int grow_array(void **ptr, size_t elem, int n_old, int n) {
   return SP_OK;
 }
 
+/** The energy of the fields (without the shape term) of the run's state. */
+static int field_energy(sp_run *run, double *energy) {
+  sp_energy_parts parts;
+  if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
+    return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
+  *energy = parts.bulk + parts.gradient + parts.repulsion + parts.buffer;
+  return SP_OK;
+}
+
 /** Make (layout, state) the run's own, resize the per-pair buffers and
  *  hand the layout to the solver. */
 static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
@@ -189,13 +200,20 @@ static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
 static int update_supports(sp_run *run) {
   const double t0 = wall_clock();
   sp_layout *layout;
-  double *state, correction;
-  SP_CALL(sp_support_rebuild(run->support, run->layout, run->state, &layout, &state, &correction));
+  double *state, correction, e_before = 0, e_after = 0;
+  SP_CALL(field_energy(run, &e_before));
+  const int always = run->scene->layout.shrink == SP_SHRINK_ALWAYS;
+  SP_CALL(sp_support_rebuild(run->support, run->layout, run->state,
+                             always ? NULL : run->divided_now, &layout, &state, &correction));
+  memset(run->divided_now, 0, (size_t)run->layout->n_cells);
   SP_CALL(adopt_layout(run, layout, state));
+  SP_CALL(field_energy(run, &e_after));
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            run->scene->division.observe_threshold, run->obs));
   run->sum->layout_changes += 1;
   if (correction > run->sum->support_mass_correction) run->sum->support_mass_correction = correction;
+  const double rise = (e_after - e_before) / fabs(e_before);
+  if (rise > run->sum->support_energy_rise) run->sum->support_energy_rise = rise;
   run->sum->t_layout += wall_clock() - t0;
   return SP_OK;
 }
@@ -259,6 +277,8 @@ static int divide_cell(sp_run *run, int parent, double t, int step) {
   SP_CALL(grow_array((void **)&run->birth, sizeof *run->birth, n, n + 1));
   SP_CALL(grow_array((void **)&run->source_on, sizeof *run->source_on, n, n + 1));
   SP_CALL(grow_array((void **)&run->division_skipped, sizeof(int), n, n + 1));
+  SP_CALL(grow_array((void **)&run->divided_now, 1, n, n + 1));
+  run->divided_now[parent] = run->divided_now[child] = 1;
   run->source_on[child] = run->source_on[parent];
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            run->scene->division.observe_threshold, run->obs));
@@ -306,38 +326,6 @@ static int divide_due_cells(sp_run *run, double t_old, double t, int step,
   return SP_OK;
 }
 
-/** Relative rise of the energy over a passive step that time.energy_guard
- *  tolerates: Newton's tolerance and round-off move a converged energy by
- *  far less (~1e-13 relative in the tests). */
-#define SP_ENERGY_GUARD_TOLERANCE 1e-10
-
-/** Whether any cell's source may inject mass (and energy) in this step. */
-static int any_source_on(int n_cells, const int *source_on, double rate) {
-  if (!(rate > 0) || !source_on) return 0;
-  for (int k = 0; k < n_cells; ++k)
-    if (source_on[k]) return 1;
-  return 0;
-}
-
-/** time.energy_guard: *rose = 1 (with the reason) when the energy of the
- *  converged state is above the last recorded one (that of c^n, after the
- *  previous step's divisions and support changes) by more than the
- *  tolerance. Only for steps without source, division or shape term, whose
- *  exact flow never raises the energy. */
-static int energy_rose(sp_run *run, char *reason, size_t reason_size, int *rose) {
-  *rose = 0;
-  sp_energy_parts parts;
-  if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
-    return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
-  const double e_new = parts.bulk + parts.gradient + parts.repulsion + parts.buffer;
-  const double e_old = run->energy_total[run->n_energy - 1];
-  if (e_new <= e_old + SP_ENERGY_GUARD_TOLERANCE * fabs(e_old)) return SP_OK;
-  *rose = 1;
-  snprintf(reason, reason_size, "the energy rose from %.10g to %.10g (time.energy_guard)",
-           e_old, e_new);
-  return SP_OK;
-}
-
 /** The time loop proper. */
 static int run_steps(sp_run *run, sp_run_summary *sum) {
   const sp_scene_time *tc = &run->scene->time;
@@ -353,7 +341,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   /* the shape penalty's per-cell coefficients, refreshed before each step */
   const int shape_on = run->scene->shape.delta1 > 0 || run->scene->shape.delta2 > 0;
   sp_shape_coef *shape_coef = NULL;
-  sp_step_seconds seconds = {0, 0, 0, 0}; /* of the step being attempted */
+  sp_step_costs seconds = {0, 0, 0, 0, 0, 0}; /* of the step being attempted */
   double step_start = -1;
   int rc = SP_OK;
   while (rc == SP_OK && t < tc->t_end - t_tol && step < tc->max_steps) {
@@ -398,15 +386,6 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                         sp_solver_last_error(run->solver));
       break;
     }
-    if (solved == 0 && tc->energy_guard && !shape_on &&
-        !any_source_on(run->layout->n_cells, run->source_on, run->scene->source.rate)) {
-      rc = energy_rose(run, report.reason, sizeof report.reason, &solved);
-      if (rc != SP_OK) break;
-      sum->energy_rejections += solved;
-      if (solved && run->rank == 0)
-        fprintf(stderr, "softpack: step %d at t = %.6g, dt = %.3g: %s; retried with dt x %g\n",
-                step + 1, t, dt_try, report.reason, tc->shrink);
-    }
     if (solved == 1) { /* never accept: shrink and retry from the last good state */
       memcpy(run->state, run->state_old, n_values * sizeof(double));
       ++failures;
@@ -448,8 +427,12 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     if (rc == SP_OK) rc = divide_due_cells(run, t_old, t, step, core_mass_old, &n_divided);
     if (rc != SP_OK) break;
     if (rc == SP_OK && run->support &&
-        (n_divided || sp_support_needs_update(run->support, run->layout, run->state)))
+        (n_divided || sp_support_needs_update(run->support, run->layout, run->state))) {
+      const double t_layout = run->sum->t_layout;
       rc = update_supports(run);
+      seconds.supports = run->sum->t_layout - t_layout;
+      seconds.support_changed = 1;
+    }
     if (rc != SP_OK) break;
     if (n_divided) {
       since_division = 0;
@@ -467,7 +450,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     }
     seconds.step = wall_clock() - step_start;
     rc = record_energy(run, step, t, dt_try, report.newton_its, &seconds);
-    seconds = (sp_step_seconds){0, 0, 0, 0};
+    seconds = (sp_step_costs){0, 0, 0, 0, 0, 0};
     step_start = -1;
     if (rc != SP_OK) break;
     const int last = !(t < tc->t_end - t_tol && step < tc->max_steps);
@@ -493,6 +476,7 @@ static void run_free(sp_run *run) {
   free(run->birth);
   free(run->source_on);
   free(run->division_skipped);
+  free(run->divided_now);
   free(run->source);
   sp_support_destroy(&run->support);
 }
@@ -544,6 +528,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   SP_ALLOC(run->birth, n);
   SP_ALLOC(run->source_on, n);
   SP_ALLOC(run->division_skipped, n);
+  SP_ALLOC(run->divided_now, n);
   SP_CALL(sp_cells_initial_state(scene, run->mesh, run->layout, run->state));
   SP_CALL(renumber_rcb(run));
   SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
@@ -572,7 +557,9 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
      * noise exist only there (docs/local-support.md). */
     const double d = sp_scene_interface_width(scene);
     sp_support_params sp = {.margin = ly->margin * d, .core_threshold = ly->core_threshold,
-                            .grow_threshold = ly->grow_threshold, .band = ly->band * d};
+                            .grow_threshold = ly->grow_threshold, .band = ly->band * d,
+                            .alpha = run->model.alpha, .lambda = run->model.lambda,
+                            .lambda_b = run->model.lambda_b};
     SP_CALL(sp_support_create(run->mesh, &sp, &run->support));
     unsigned char *mask;
     SP_ALLOC(mask, (size_t)run->mesh->n_nodes * n);

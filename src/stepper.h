@@ -23,8 +23,6 @@ extern "C" {
 typedef struct {
   int steps;           /**< accepted steps */
   int failed_attempts; /**< Newton failures that were retried */
-  int energy_rejections; /**< of those: converged steps rejected by
-                              time.energy_guard (the energy rose) */
   long newton_its;     /**< Newton iterations of accepted steps */
   double t_final;      /**< time reached */
   double dt_smallest;  /**< smallest accepted dt */
@@ -36,6 +34,9 @@ typedef struct {
   double support_mass_correction; /**< largest relative mass change a
                                        support change caused (restored) */
   double t_layout;     /**< seconds spent rebuilding supports */
+  double support_energy_rise; /**< largest relative rise of the field
+                                   energy at a support change (0 if none
+                                   rose) */
   long unknowns_max;   /**< largest number of unknowns of a step */
 } sp_run_summary;
 

@@ -12,7 +12,6 @@ struct sp_support_s {
   const sp_mesh *mesh;
   sp_support_params params;
   int *ne_start, *ne_list; /* elements around each node (CSR) */
-  double *elem_area;
   /* scratch, n_nodes each */
   int *source, *queue;
   double *best;
@@ -31,7 +30,6 @@ int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_s
   const int nn = mesh->n_nodes, ne = mesh->n_elems;
   SP_ALLOC(s->ne_start, nn + 1);
   SP_ALLOC(s->ne_list, 4 * (size_t)ne);
-  SP_ALLOC(s->elem_area, ne);
   SP_ALLOC(s->source, nn);
   SP_ALLOC(s->queue, nn);
   SP_ALLOC(s->best, nn);
@@ -46,12 +44,6 @@ int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_s
       int n = mesh->elem[4 * e + a];
       s->ne_list[s->ne_start[n] + fill[n]++] = e;
     }
-    double xy[4][2], N[4], dN[4][2], x[2], w;
-    sp_mesh_elem_xy(mesh, e, xy);
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      sp_q1_point(xy, q, N, dN, x, &w);
-      s->elem_area[e] += w;
-    }
   }
   free(fill);
   return SP_OK;
@@ -61,7 +53,6 @@ void sp_support_destroy(sp_support *s) {
   if (!s || !*s) return;
   free((*s)->ne_start);
   free((*s)->ne_list);
-  free((*s)->elem_area);
   free((*s)->source);
   free((*s)->queue);
   free((*s)->best);
@@ -190,20 +181,22 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout, const double 
   return grow;
 }
 
-/** Area of the whole elements of cell k. */
-static double support_area(sp_support s, const sp_layout *layout, int k) {
-  double area = 0;
-  for (int e = 0; e < s->mesh->n_elems; ++e) {
-    const int *nodes = s->mesh->elem + 4 * e;
-    int whole = 1;
-    for (int a = 0; a < 4 && whole; ++a) whole = sp_layout_pair(layout, k, nodes[a]) >= 0;
-    if (whole) area += s->elem_area[e];
-  }
-  return area;
+/** The fraction of the elements around node i that are buffer ring. */
+static double buffer_share(sp_support s, int i) {
+  const int n = s->ne_start[i + 1] - s->ne_start[i];
+  if (!s->mesh->region || n == 0) return 0.0;
+  int buffer = 0;
+  for (int j = s->ne_start[i]; j < s->ne_start[i + 1]; ++j)
+    buffer += s->mesh->region[s->ne_list[j]] == SP_REGION_BUFFER;
+  return (double)buffer / n;
 }
 
+/** The interior of a cell, where support changes restore its mass. */
+#define SP_SUPPORT_INTERIOR 0.5
+
 int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *state,
-                       sp_layout **new_layout, double **new_state, double *mass_correction) {
+                       const unsigned char *may_shrink, sp_layout **new_layout,
+                       double **new_state, double *mass_correction) {
   const int nn = s->mesh->n_nodes, nc = layout->n_cells;
   *new_layout = NULL;
   *new_state = NULL;
@@ -211,6 +204,10 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   unsigned char *mask;
   SP_ALLOC(mask, (size_t)nn * (nc ? nc : 1));
   int rc = sp_support_masks(s, layout, state, mask);
+  for (int k = 0; k < nc && rc == SP_OK; ++k)
+    if (may_shrink && !may_shrink[k])
+      for (int i = 0; i < nn; ++i)
+        if (sp_layout_pair(layout, k, i) >= 0) mask[(size_t)k * nn + i] = 1;
   if (rc == SP_OK) rc = sp_support_layout_from_masks(s, nc, mask, new_layout);
   free(mask);
   SP_CALL(rc);
@@ -223,7 +220,14 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   SP_ALLOC(before, nc);
   SP_ALLOC(after, nc);
   for (int k = 0; k < nc; ++k) {
-    /* New nodes get the mean far field of the old edge. */
+    /* New nodes continue the far field: the old edge's mean c_e where the
+     * cell is alone. Where a neighbour or the buffer ring is, the far field
+     * is held down: for small c, mu = c (2 alpha + 2 lambda sum_{l != k}
+     * c_l^2 + 2 lambda_b b) (b: the node's share of buffer elements), so at
+     * the free far field's chemical potential 2 alpha c_e the node gets
+     * c_e 2 alpha / (that stiffness) (~ c_e / 25 inside a neighbour). The
+     * edge's c_e copied into a neighbour would raise the repulsion energy
+     * at first order. mu: the edge's mean. */
     double edge_c = 0, edge_mu = 0;
     int n_edge = 0;
     for (int i = 0; i < nn; ++i) {
@@ -240,27 +244,48 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
     }
     for (int i = 0; i < nn; ++i) {
       int q = sp_layout_pair(to, k, i);
-      if (q >= 0 && sp_layout_pair(layout, k, i) < 0) {
-        next[2 * q] = edge_c;
-        next[2 * q + 1] = edge_mu;
-      }
+      if (q < 0 || sp_layout_pair(layout, k, i) >= 0) continue;
+      double others = 0; /* sum over l != k of c_l^2 at node i (old state) */
+      for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p)
+        if (layout->pair_cell[p] != k) others += state[2 * p] * state[2 * p];
+      const double free_stiffness = 2 * s->params.alpha;
+      const double stiffness = free_stiffness + 2 * s->params.lambda * others +
+                               2 * s->params.lambda_b * buffer_share(s, i);
+      next[2 * q] = stiffness > 0 ? edge_c * free_stiffness / stiffness : edge_c;
+      next[2 * q + 1] = edge_mu;
     }
   }
   rc = sp_cells_observe(s->mesh, layout, state, 0.0, before);
   if (rc == SP_OK) rc = sp_cells_observe(s->mesh, to, next, 0.0, after);
+  double *w = NULL;
+  if (rc == SP_OK && !(w = malloc(sizeof(double) * (size_t)nn)))
+    rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
   for (int k = 0; k < nc && rc == SP_OK; ++k) {
-    /* A uniform shift over the support restores the mass exactly (the
-     * shape functions of a whole-element domain sum to one). */
+    /* A shift of c_k by d on a set of nodes changes the mass by d x (their
+     * weights) exactly. It goes on the cell's interior (c_k >= 1/2): there
+     * no other cell and no buffer ring is (a shift where a neighbour or the
+     * ring is raises the repulsion or buffer energy at first order) and
+     * f'(c) ~ 0; a cell without interior nodes takes it over its support. */
     const double change = after[k].mass - before[k].mass;
     const double rel = before[k].mass != 0 ? fabs(change / before[k].mass) : fabs(change);
     if (rel > *mass_correction) *mass_correction = rel;
-    const double area = support_area(s, to, k);
-    const double shift = area > 0 ? -change / area : 0.0;
-    for (int i = 0; i < nn; ++i) {
-      int q = sp_layout_pair(to, k, i);
-      if (q >= 0) next[2 * q] += shift;
+    rc = sp_cells_node_weights(s->mesh, to, k, w);
+    double w_interior = 0, w_all = 0;
+    for (int i = 0; i < nn && rc == SP_OK; ++i) {
+      const int q = sp_layout_pair(to, k, i);
+      if (q < 0) continue;
+      w_all += w[i];
+      if (next[2 * q] >= SP_SUPPORT_INTERIOR) w_interior += w[i];
+    }
+    const int interior = w_interior > 0;
+    const double weight = interior ? w_interior : w_all;
+    const double shift = weight > 0 ? -change / weight : 0.0;
+    for (int i = 0; i < nn && rc == SP_OK; ++i) {
+      const int q = sp_layout_pair(to, k, i);
+      if (q >= 0 && (!interior || next[2 * q] >= SP_SUPPORT_INTERIOR)) next[2 * q] += shift;
     }
   }
+  free(w);
   free(before);
   free(after);
   return rc;

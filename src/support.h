@@ -9,9 +9,10 @@
  * changes. When a cell's c_k exceeds the grow threshold within a band at
  * its support's edge, every support is recomputed from the current fields
  * (which may also shrink it); values move with (cell, node), new nodes get
- * the mean far-field value of the old edge, and each cell's mass is then
- * restored exactly by a uniform shift of c_k over its new support. The mass
- * changes that shift corrects are reported.
+ * the far-field value in equilibrium with the old edge's mean chemical
+ * potential (sp_support_rebuild), and each cell's mass is then
+ * restored exactly by a uniform shift of c_k over its interior (c_k >= 1/2).
+ * The mass changes that shift corrects are reported.
  */
 #ifndef SP_SUPPORT_H
 #define SP_SUPPORT_H
@@ -31,6 +32,9 @@ typedef struct {
   double core_threshold; /**< the core: nodes with c_k >= this */
   double grow_threshold; /**< grow when c_k >= this ... */
   double band;           /**< ... within this distance of the support edge */
+  /* The model (for the far-field value new nodes start from): f''(0) =
+   * 2 alpha, the repulsion lambda and the buffer ring's lambda_b. */
+  double alpha, lambda, lambda_b;
 } sp_support_params;
 
 /** @brief Node adjacency of a mesh and the parameters. */
@@ -53,12 +57,22 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout,
 /**
  * @brief New supports from the fields, values moved to them, masses
  *        restored. @p new_layout and @p new_state are allocated here.
+ *
+ * A cell k with may_shrink[k] = 0 keeps every node of its old support (the
+ * new one is the union of the old and the computed one). Shrinking drops
+ * the far field c_k keeps outside its cell (its Gibbs-Thomson level, not 0)
+ * and puts that mass back into the cell, which costs mu x (mass) against
+ * the f(c) x (area) removed: the energy rises (docs/local-support.md).
+ * Growing does the opposite and lowers it.
+ *
+ * @param[in] may_shrink n_cells flags (NULL: every cell may shrink)
  * @param[out] mass_correction largest |mass change before correction| /
- *             mass over the cells (what the uniform shift restored)
+ *             mass over the cells (what the shift restored)
  */
 int sp_support_rebuild(sp_support s, const sp_layout *layout,
-                       const double *state, sp_layout **new_layout,
-                       double **new_state, double *mass_correction);
+                       const double *state, const unsigned char *may_shrink,
+                       sp_layout **new_layout, double **new_state,
+                       double *mass_correction);
 
 /** @brief Layout from per-cell masks, with every cell's mask closed to
  *         whole elements (no node without a whole element of its cell). */

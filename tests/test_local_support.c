@@ -15,6 +15,10 @@
 #include "error.h"
 #include "scene.h"
 #include "stepper.h"
+#include "support.h"
+#include "cells.h"
+#include "layout.h"
+#include "mesh.h"
 
 /* The c of every cell at every node from the run's last fields_*.vtu is
  * not needed: the solutions are compared through cells.csv and energy.csv. */
@@ -67,8 +71,103 @@ static sp_run_summary run(const char *scene_file, int n_set, const char **set, c
   return sum;
 }
 
+/* sp_support_rebuild on its own: cell 0 (a disk with a far field c_e =
+ * 0.02) on a support of 3 interface widths grows to 10 widths, into its
+ * neighbour cell 1. Checked: with may_shrink = 0 every old node is kept;
+ * the masses are kept to round-off; the nodes already in the support keep
+ * their values except in the interior (c >= 1/2), which alone takes the
+ * mass correction; new nodes where the cell is alone all get the old
+ * edge's mean c, new nodes inside the neighbour (c_1 > 0.9) at most that x
+ * 2 alpha / (2 alpha + 2 lambda 0.81) ~ 1/21. */
+static void test_rebuild_growth(void) {
+  sp_mesh *mesh;
+  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 0.6, 80, 48, &mesh));
+  const int nn = mesh->n_nodes;
+  const double d = sqrt(1e-3 / 8.0), c_e = 0.02, alpha = 4, lambda = 100;
+  sp_layout *full;
+  CHECK_OK(sp_layout_create_full(nn, 2, &full));
+  double *state = calloc(2 * (size_t)full->n_pairs, sizeof(double));
+  const double cx[2] = {0.40, 0.63}, r[2] = {0.12, 0.10};
+  for (int i = 0; i < nn; ++i)
+    for (int k = 0; k < 2; ++k) {
+      const double dist = hypot(mesh->xy[2 * i] - cx[k], mesh->xy[2 * i + 1] - 0.3) - r[k];
+      const double p = 1.0 / (1.0 + exp(dist / d));
+      state[2 * sp_layout_pair(full, k, i)] = p + (1 - p) * (k == 0 ? c_e : 0.0);
+      state[2 * sp_layout_pair(full, k, i) + 1] = 0.1;
+    }
+  sp_support_params narrow = {.margin = 3 * d, .core_threshold = 0.1, .grow_threshold = 0.1,
+                              .band = 2 * d, .alpha = alpha, .lambda = lambda, .lambda_b = 0};
+  sp_support_params wide = narrow;
+  wide.margin = 10 * d;
+  sp_support s_narrow, s_wide;
+  CHECK_OK(sp_support_create(mesh, &narrow, &s_narrow));
+  CHECK_OK(sp_support_create(mesh, &wide, &s_wide));
+  unsigned char *mask = calloc((size_t)nn * 2, 1);
+  CHECK_OK(sp_support_masks(s_narrow, full, state, mask));
+  for (int i = 0; i < nn; ++i) mask[nn + i] = 1; /* cell 1 everywhere */
+  sp_layout *layout, *grown;
+  CHECK_OK(sp_support_layout_from_masks(s_narrow, 2, mask, &layout));
+  double *st = calloc(2 * (size_t)layout->n_pairs, sizeof(double)), *next, correction;
+  sp_layout_transfer(full, state, layout, st, 0.0);
+  const unsigned char keep[2] = {0, 0};
+  CHECK_OK(sp_support_rebuild(s_wide, layout, st, keep, &grown, &next, &correction));
+  sp_cell_obs before[2], after[2];
+  CHECK_OK(sp_cells_observe(mesh, layout, st, 0.0, before));
+  CHECK_OK(sp_cells_observe(mesh, grown, next, 0.0, after));
+  int lost = 0, changed_outside = 0, n_new_alone = 0, n_new_inside = 0, n_old = 0, n_new = 0;
+  double shift = 0, worst_alone = 0, worst_inside = 0, c_alone = 0;
+  for (int i = 0; i < nn; ++i) {
+    const int p_old = sp_layout_pair(layout, 0, i), p_new = sp_layout_pair(grown, 0, i);
+    if (p_old >= 0 && p_new < 0) ++lost;
+    n_old += p_old >= 0;
+    n_new += p_new >= 0;
+    if (p_new < 0) continue;
+    const double c = next[2 * p_new];
+    if (p_old >= 0) {
+      const double c_old = st[2 * p_old];
+      if (c_old < 0.5 && c != c_old) ++changed_outside;
+      if (c_old >= 0.5) shift = c - c_old;
+      continue;
+    }
+    const double c1 = state[2 * sp_layout_pair(full, 1, i)];
+    if (c1 < 1e-3) {
+      if (n_new_alone++ == 0) c_alone = c;
+      worst_alone = fmax(worst_alone, fabs(c - c_alone));
+    } else if (c1 > 0.9) {
+      ++n_new_inside;
+      worst_inside = fmax(worst_inside, c);
+    }
+  }
+  worst_inside /= c_alone;
+  printf("rebuild: %d -> %d pairs of cell 0; new nodes alone %d (c = %.4f = %.2f c_e, spread "
+         "%.1e), inside the neighbour %d (c <= %.3f of that); interior shift %.2e; mass %.17g -> "
+         "%.17g (correction %.2e)\n", n_old, n_new, n_new_alone, c_alone, c_alone / c_e,
+         worst_alone, n_new_inside, worst_inside, shift,
+         before[0].mass, after[0].mass, correction);
+  CHECK(lost == 0, "%d nodes of a support that may not shrink were dropped", lost);
+  CHECK(changed_outside == 0, "%d nodes outside the interior changed", changed_outside);
+  CHECK(n_new_alone > 0 && n_new_inside > 0, "the growth must reach both kinds of node "
+        "(%d alone, %d inside)", n_new_alone, n_new_inside);
+  /* away from the neighbour: the old edge's mean c, the same at every new
+   * node but for the 1e-3 of the neighbour nearby (with a 3-width support
+   * the tanh tail still adds to c_e there) */
+  CHECK(worst_alone <= 1e-4 * c_alone && c_alone > c_e && c_alone < 5 * c_e,
+        "new nodes away from the neighbour: c = %.4g (c_e %.3g), spread %.3g", c_alone, c_e,
+        worst_alone);
+  CHECK(worst_inside <= 2 * alpha / (2 * alpha + 2 * lambda * 0.81),
+        "new nodes inside the neighbour: c up to %.3g x the free far field", worst_inside);
+  for (int k = 0; k < 2; ++k)
+    CHECK(fabs(after[k].mass - before[k].mass) <= 1e-13 * before[k].mass,
+          "cell %d mass %.17g -> %.17g", k + 1, before[k].mass, after[k].mass);
+  free(state); free(st); free(next); free(mask);
+  sp_layout_destroy(&full); sp_layout_destroy(&layout); sp_layout_destroy(&grown);
+  sp_support_destroy(&s_narrow); sp_support_destroy(&s_wide);
+  sp_mesh_destroy(&mesh);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
+  test_rebuild_growth();
   /* 1. local = full on a short scene with a wide margin */
   const char *full_set[] = {"layout.support=full"};
   const char *wide_set[] = {"layout.margin=40", "layout.band=10"};
@@ -112,8 +211,9 @@ int main(int argc, char **argv) {
     }
   if (fc) fclose(fc);
   read_last_cells("local_push/cells.csv", 2, m1, x1, y1);
-  printf("pushed cell: x %.4f -> %.4f, %d support changes, mass %.15g -> %.15g\n", x0[1], x1[1],
-         p.layout_changes, m0[1], m1[1]);
+  printf("pushed cell: x %.4f -> %.4f, %d support changes, mass %.15g -> %.15g; largest mass "
+         "change restored %.2e, largest energy rise at a change %.2e\n", x0[1], x1[1],
+         p.layout_changes, m0[1], m1[1], p.support_mass_correction, p.support_energy_rise);
   CHECK(p.layout_changes >= 1, "the supports never changed");
   CHECK(x1[1] - x0[1] > 0.01, "the small cell did not move: %g -> %g", x0[1], x1[1]);
   for (int k = 0; k < 2; ++k)
@@ -122,8 +222,9 @@ int main(int argc, char **argv) {
 
   /* 3. supports clipped by the ellipse and its buffer ring */
   sp_run_summary b = run("local_edge.yaml", 0, NULL, "local_edge");
-  printf("edge scene: %d steps, %d support changes, %ld unknowns at most\n", b.steps,
-         b.layout_changes, b.unknowns_max);
+  printf("edge scene: %d steps, %d support changes, %ld unknowns at most; largest mass change "
+         "restored %.2e, largest energy rise at a change %.2e\n", b.steps, b.layout_changes,
+         b.unknowns_max, b.support_mass_correction, b.support_energy_rise);
   CHECK(b.steps > 0 && fabs(b.t_final - 0.004) < 1e-12, "edge scene reached t = %g", b.t_final);
 
   /* 4. division under local supports */
@@ -132,8 +233,10 @@ int main(int argc, char **argv) {
   CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 1, div_set, &scene));
   sp_run_summary d;
   CHECK_OK(sp_stepper_run(scene, "local_divide", MPI_COMM_WORLD, &d));
-  printf("division, local supports: %d cells, %d divisions, %d support changes, max %ld unknowns\n",
-         d.n_cells, d.divisions, d.layout_changes, d.unknowns_max);
+  printf("division, local supports: %d cells, %d divisions, %d support changes, max %ld unknowns; "
+         "largest mass change restored %.2e, largest energy rise at a change %.2e\n",
+         d.n_cells, d.divisions, d.layout_changes, d.unknowns_max, d.support_mass_correction,
+         d.support_energy_rise);
   CHECK(d.n_cells == 4 && d.divisions == 3, "%d cells, %d divisions", d.n_cells, d.divisions);
   double md[4], xd[4], yd[4];
   read_last_cells("local_divide/cells.csv", 4, md, xd, yd);
