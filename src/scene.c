@@ -347,12 +347,13 @@ static const sp_key sp_keys[] = {
               "of a support's edge"),
     KEY_FLOAT(SP_SEC_LAYOUT, "band", layout.band, 4.0, ABOVE(0.0), UNBOUNDED,
               "d", "local: width of that band in interface widths (< margin)"),
-    KEY_ENUM(SP_SEC_LAYOUT, "shrink", layout.shrink, SP_SHRINK_DIVISIONS, sp_shrink_words,
+    KEY_ENUM(SP_SEC_LAYOUT, "shrink", layout.shrink, SP_SHRINK_ALWAYS, sp_shrink_words,
              "-",
-             "local: supports grow whenever a cell needs it; they shrink only "
-             "for the two daughters of a division (divisions), or at every "
-             "support change (always: fewer unknowns, but dropping and "
-             "restoring far-field mass raises the energy)"),
+             "local: supports grow whenever a cell needs it; they shrink at "
+             "every support change (always), or only for the two daughters "
+             "of a division (divisions: no energy rise from dropping "
+             "far-field mass, but supports trail moving and growing cells: "
+             "many more unknowns in growth runs)"),
     /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
      * in E L^2, so delta is in E / L^6 */
     KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),

@@ -129,8 +129,8 @@ typedef struct {
   double core_threshold;   /**< local: the core is c_k >= this */
   double grow_threshold;   /**< local: grow when c_k >= this ... */
   double band;             /**< ... within this many widths of the edge */
-  sp_shrink_kind shrink;   /**< local: shrink only the supports of dividing
-                                cells, or at every support change */
+  sp_shrink_kind shrink;   /**< local: shrink at every support change, or
+                                only the supports of dividing cells */
 } sp_scene_layout;
 
 /** shape: the shape penalty on principal moments (MODEL.md, paper sec. 3). */

@@ -11,10 +11,10 @@
 #include "error.h"
 #include "layout.h"
 #include "output.h"
+#include "partition.h"
 #include "render.h"
 #include "shape.h"
 #include "source.h"
-#include "partition.h"
 #include "support.h"
 
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
