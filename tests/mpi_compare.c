@@ -30,58 +30,7 @@
 
 #include "fixtures.h"
 #include "scene.h"
-#include "vtu_read.h"
-
-/* ---------- CSV files ---------- */
-
-typedef struct {
-  int n_rows, n_cols;
-  char header[1024];
-  double *v; /* n_rows x n_cols */
-} csv_table;
-
-static int csv_read(const char *path, csv_table *t) {
-  memset(t, 0, sizeof *t);
-  FILE *f = fopen(path, "r");
-  if (!f) return -1;
-  char line[4096];
-  int cap = 0;
-  if (!fgets(t->header, sizeof t->header, f)) {
-    fclose(f);
-    return -1;
-  }
-  t->n_cols = 1;
-  for (const char *c = t->header; *c; ++c) t->n_cols += *c == ',';
-  while (fgets(line, sizeof line, f)) {
-    if (t->n_rows == cap) {
-      cap = cap ? 2 * cap : 256;
-      t->v = realloc(t->v, (size_t)cap * t->n_cols * sizeof(double));
-    }
-    char *s = line;
-    for (int j = 0; j < t->n_cols; ++j) {
-      t->v[(size_t)t->n_rows * t->n_cols + j] = strtod(s, &s);
-      if (*s == ',') ++s;
-    }
-    ++t->n_rows;
-  }
-  fclose(f);
-  return 0;
-}
-
-static int csv_col(const csv_table *t, const char *name) {
-  char h[1024];
-  snprintf(h, sizeof h, "%s", t->header);
-  h[strcspn(h, "\r\n")] = '\0';
-  int j = 0;
-  for (char *tok = strtok(h, ","); tok; tok = strtok(NULL, ","), ++j)
-    if (strcmp(tok, name) == 0) return j;
-  CHECK(0, "no column %s", name);
-  return 0;
-}
-
-static double at(const csv_table *t, int i, const char *name) {
-  return t->v[(size_t)i * t->n_cols + csv_col(t, name)];
-}
+#include "output_read.h"
 
 static double rel(double a, double b) {
   double s = fmax(fabs(a), fabs(b));
@@ -90,21 +39,22 @@ static double rel(double a, double b) {
 
 /* ---------- steps: a scene on P ranks against one ---------- */
 
-static void compare_runs(const char *ref, const char *par) {
+/** Read DIR/NAME of both runs into @p r and @p p (a failed read is a failed
+ *  check). */
+static void read_both(const char *ref, const char *par, const char *name, csv_table *r,
+                      csv_table *p) {
   char path[2048];
+  snprintf(path, sizeof path, "%s/%s", ref, name);
+  CHECK(csv_read(path, r) == 0, "cannot read %s", path);
+  snprintf(path, sizeof path, "%s/%s", par, name);
+  CHECK(csv_read(path, p) == 0, "cannot read %s", path);
+}
+
+static void compare_runs(const char *ref, const char *par) {
   csv_table er, ep, cr, cp, dr, dp;
-  snprintf(path, sizeof path, "%s/energy.csv", ref);
-  CHECK(csv_read(path, &er) == 0, "cannot read %s", path);
-  snprintf(path, sizeof path, "%s/energy.csv", par);
-  CHECK(csv_read(path, &ep) == 0, "cannot read %s", path);
-  snprintf(path, sizeof path, "%s/cells.csv", ref);
-  CHECK(csv_read(path, &cr) == 0, "cannot read %s", path);
-  snprintf(path, sizeof path, "%s/cells.csv", par);
-  CHECK(csv_read(path, &cp) == 0, "cannot read %s", path);
-  snprintf(path, sizeof path, "%s/divisions.csv", ref);
-  CHECK(csv_read(path, &dr) == 0, "cannot read %s", path);
-  snprintf(path, sizeof path, "%s/divisions.csv", par);
-  CHECK(csv_read(path, &dp) == 0, "cannot read %s", path);
+  read_both(ref, par, "energy.csv", &er, &ep);
+  read_both(ref, par, "cells.csv", &cr, &cp);
+  read_both(ref, par, "divisions.csv", &dr, &dp);
   if (sp_test_failures) return;
 
   CHECK(er.n_rows == ep.n_rows, "energy rows %d vs %d", er.n_rows, ep.n_rows);

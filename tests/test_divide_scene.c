@@ -8,27 +8,9 @@
 
 #include "check.h"
 #include "error.h"
+#include "output_read.h"
 #include "scene.h"
 #include "stepper.h"
-
-static double total_mass_at(const char *path, int want_step, int *n_cells, double *masses) {
-  FILE *f = fopen(path, "r");
-  char line[1024];
-  double total = 0;
-  *n_cells = 0;
-  if (!f) return NAN;
-  if (!fgets(line, sizeof line, f)) { fclose(f); return NAN; }
-  while (fgets(line, sizeof line, f)) {
-    int step, cell;
-    double t, m;
-    if (sscanf(line, "%d,%lf,%d,%lf", &step, &t, &cell, &m) == 4 && step == want_step) {
-      total += m;
-      if (*n_cells < 16) masses[(*n_cells)++] = m;
-    }
-  }
-  fclose(f);
-  return total;
-}
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
@@ -45,8 +27,8 @@ int main(int argc, char **argv) {
 
   int n0, n1;
   double m0[16], m1[16];
-  double total0 = total_mass_at("test_divide_out/cells.csv", 0, &n0, m0);
-  double total1 = total_mass_at("test_divide_out/cells.csv", sum.steps, &n1, m1);
+  double total0 = cells_mass_at("test_divide_out/cells.csv", 0, 16, &n0, m0);
+  double total1 = cells_mass_at("test_divide_out/cells.csv", sum.steps, 16, &n1, m1);
   double drift = fabs(total1 - total0) / total0;
   printf("total cell mass %.15g -> %.15g (relative drift %.3g)\n", total0, total1, drift);
   CHECK(n0 == 1 && n1 == 4, "cells at start %d, end %d", n0, n1);

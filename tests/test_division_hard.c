@@ -11,6 +11,7 @@
 
 #include "check.h"
 #include "error.h"
+#include "output_read.h"
 #include "scene.h"
 #include "stepper.h"
 
@@ -37,21 +38,6 @@ static int count_rows(const char *path, int *same_step) {
   return rows;
 }
 
-static double total_mass(const char *path, int want_step) {
-  FILE *f = fopen(path, "r");
-  char line[1024];
-  double total = 0;
-  if (!f) return NAN;
-  if (!fgets(line, sizeof line, f)) { fclose(f); return NAN; }
-  while (fgets(line, sizeof line, f)) {
-    int step, cell;
-    double t, m;
-    if (sscanf(line, "%d,%lf,%d,%lf", &step, &t, &cell, &m) == 4 && step == want_step) total += m;
-  }
-  fclose(f);
-  return total;
-}
-
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   sp_scene *scene;
@@ -60,7 +46,8 @@ int main(int argc, char **argv) {
   CHECK_OK(sp_stepper_run(scene, "hard_eight", MPI_COMM_WORLD, &sum));
   int same_step;
   int rows = count_rows("hard_eight/divisions.csv", &same_step);
-  double m0 = total_mass("hard_eight/cells.csv", 0), m1 = total_mass("hard_eight/cells.csv", sum.steps);
+  double m0 = cells_mass_at("hard_eight/cells.csv", 0, 0, NULL, NULL),
+         m1 = cells_mass_at("hard_eight/cells.csv", sum.steps, 0, NULL, NULL);
   printf("eight at once: %d cells, %d divisions (same step: %s), total mass %.15g -> %.15g\n",
          sum.n_cells, rows, same_step ? "yes" : "no", m0, m1);
   CHECK(sum.n_cells == 16 && rows == 8 && same_step, "%d cells, %d divisions", sum.n_cells, rows);

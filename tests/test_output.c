@@ -16,7 +16,7 @@
 #include "layout.h"
 #include "output.h"
 #include "render.h"
-#include "vtu_read.h"
+#include "output_read.h"
 
 #define DIR "test_output_tmp/run/a"
 #define NX 6

@@ -1,0 +1,149 @@
+/* Reading what src/output.c writes, for tests: whole files, the CSV logs
+ * (energy.csv, cells.csv, divisions.csv) by column name, and the
+ * DataArrays of a .vtu (inline base64 with a UInt64 byte-count header). */
+#ifndef SP_TEST_OUTPUT_READ_H
+#define SP_TEST_OUTPUT_READ_H
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+
+/* A CSV log with a header line: every value as a double. */
+typedef struct {
+  int n_rows, n_cols;
+  char header[1024];
+  double *v; /* n_rows x n_cols */
+} csv_table;
+
+static inline int csv_read(const char *path, csv_table *t) {
+  memset(t, 0, sizeof *t);
+  FILE *f = fopen(path, "r");
+  if (!f) return -1;
+  char line[4096];
+  int cap = 0;
+  if (!fgets(t->header, sizeof t->header, f)) {
+    fclose(f);
+    return -1;
+  }
+  t->n_cols = 1;
+  for (const char *c = t->header; *c; ++c) t->n_cols += *c == ',';
+  while (fgets(line, sizeof line, f)) {
+    if (t->n_rows == cap) {
+      cap = cap ? 2 * cap : 256;
+      t->v = realloc(t->v, (size_t)cap * t->n_cols * sizeof(double));
+    }
+    char *s = line;
+    for (int j = 0; j < t->n_cols; ++j) {
+      t->v[(size_t)t->n_rows * t->n_cols + j] = strtod(s, &s);
+      if (*s == ',') ++s;
+    }
+    ++t->n_rows;
+  }
+  fclose(f);
+  return 0;
+}
+
+static inline int csv_col(const csv_table *t, const char *name) {
+  char h[1024];
+  snprintf(h, sizeof h, "%s", t->header);
+  h[strcspn(h, "\r\n")] = '\0';
+  int j = 0;
+  for (char *tok = strtok(h, ","); tok; tok = strtok(NULL, ","), ++j)
+    if (strcmp(tok, name) == 0) return j;
+  CHECK(0, "no column %s", name);
+  return 0;
+}
+
+static inline double at(const csv_table *t, int i, const char *name) {
+  return t->v[(size_t)i * t->n_cols + csv_col(t, name)];
+}
+
+/** The total mass of the cells at @p step in cells.csv (NAN if unreadable);
+ *  the first @p cap masses go to @p masses and their count to @p n_cells
+ *  (both may be NULL). */
+static inline double cells_mass_at(const char *path, int step, int cap, int *n_cells,
+                                   double *masses) {
+  csv_table t;
+  if (n_cells) *n_cells = 0;
+  if (csv_read(path, &t) != 0) return NAN;
+  double total = 0;
+  for (int i = 0; i < t.n_rows; ++i) {
+    if (at(&t, i, "step") != step) continue;
+    const double m = at(&t, i, "mass");
+    total += m;
+    if (n_cells && masses && *n_cells < cap) masses[(*n_cells)++] = m;
+  }
+  free(t.v);
+  return total;
+}
+
+/* The whole file as a string (NULL if unreadable); its length in *len. */
+static inline char *slurp(const char *path, size_t *len) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return NULL;
+  fseek(f, 0, SEEK_END);
+  long n = ftell(f);
+  fseek(f, 0, SEEK_SET);
+  char *s = malloc((size_t)n + 1);
+  size_t got = fread(s, 1, (size_t)n, f);
+  s[got] = '\0';
+  fclose(f);
+  if (len) *len = got;
+  return s;
+}
+
+static inline int b64_value(char c) {
+  if (c >= 'A' && c <= 'Z') return c - 'A';
+  if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+  if (c >= '0' && c <= '9') return c - '0' + 52;
+  if (c == '+') return 62;
+  if (c == '/') return 63;
+  return -1;
+}
+
+/* Decode base64 from s up to '<'. A padded quad may also occur mid-stream
+ * (some writers encode the header separately), so accept that too.
+ * Returns the byte count. */
+static inline size_t b64_decode(const char *s, unsigned char *out, size_t cap) {
+  size_t n = 0;
+  char q[4];
+  int nq = 0;
+  for (; *s && *s != '<'; ++s) {
+    if (*s == ' ' || *s == '\n' || *s == '\r' || *s == '\t') continue;
+    q[nq++] = *s;
+    if (nq < 4) continue;
+    nq = 0;
+    int pad = (q[2] == '=') + (q[3] == '=');
+    unsigned v = 0;
+    for (int i = 0; i < 4; ++i)
+      v = v << 6 | (unsigned)(q[i] == '=' ? 0 : b64_value(q[i]));
+    unsigned char b[3] = {(unsigned char)(v >> 16), (unsigned char)(v >> 8),
+                          (unsigned char)v};
+    for (int i = 0; i < 3 - pad && n < cap; ++i) out[n++] = b[i];
+  }
+  return n;
+}
+
+/* The data of DataArray @p name in @p xml after its UInt64 byte-count
+ * header: a malloc'd copy, its length in *bytes; NULL if absent or short. */
+static inline unsigned char *vtu_array_data(const char *xml, const char *name, size_t *bytes) {
+  char key[64];
+  snprintf(key, sizeof key, "Name=\"%s\"", name);
+  const char *p = strstr(xml, key);
+  if (!p || !(p = strchr(p, '>'))) return NULL;
+  const size_t cap = strlen(p);
+  unsigned char *raw = malloc(cap + 8);
+  const size_t n = b64_decode(p + 1, raw, cap);
+  uint64_t header = 0;
+  if (n >= 8) memcpy(&header, raw, 8);
+  if (n < 8 || n != 8 + header) {
+    free(raw);
+    return NULL;
+  }
+  memmove(raw, raw + 8, header);
+  *bytes = header;
+  return raw;
+}
+#endif
