@@ -219,7 +219,7 @@ int sp_output_open(const char *dir, sp_output *out) {
     rc = sp_log_open(o->energy_path,
                      "step,t,dt,newton_its,n_cells,energy,bulk,gradient,"
                      "repulsion,buffer,shape,seconds,assembly_s,factorisation_s,solves_s,"
-                     "supports_s,support_changed",
+                     "supports_s,support_changed,unknowns",
                      &o->energy);
   if (rc == SP_OK)
     rc = sp_log_open(o->cells_path, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass",
@@ -241,16 +241,16 @@ int sp_output_energy(sp_output out, int step, double t, double dt,
                      double shape, const sp_step_costs *seconds) {
   sp_energy_parts p = {0, 0, 0, 0};
   if (parts) p = *parts;
-  sp_step_costs w = {0, 0, 0, 0, 0, 0};
+  sp_step_costs w = {0};
   if (seconds) w = *seconds;
   double total = p.bulk + p.gradient + p.repulsion + p.buffer + shape;
   /* %.17g: every double prints to a string that reads back bit-exact. */
   int n = fprintf(out->energy,
                   "%d,%.17g,%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
-                  "%.4g,%.4g,%.4g,%.4g,%.4g,%d\n",
+                  "%.4g,%.4g,%.4g,%.4g,%.4g,%d,%ld\n",
                   step, t, dt, newton_its, n_cells, total, p.bulk, p.gradient,
                   p.repulsion, p.buffer, shape, w.step, w.assembly, w.factorisation,
-                  w.solves, w.supports, w.support_changed);
+                  w.solves, w.supports, w.support_changed, w.unknowns);
   return sp_log_done(out->energy, out->energy_path, n);
 }
 

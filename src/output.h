@@ -23,15 +23,19 @@ int sp_output_open(const char *dir, sp_output *out);
 
 /** What one accepted step cost, in wall-clock seconds of rank 0: the whole
  *  step (every attempt, divisions, support changes), the solver's phases
- *  and the support change (local supports), and whether one happened. */
+ *  and the support change (local supports), whether one happened, and the
+ *  unknowns of the Newton system the step solved (2 x the (cell, node)
+ *  pairs of the layout before any support change after it). */
 typedef struct {
   double step, assembly, factorisation, solves, supports;
   int support_changed;
+  long unknowns;
 } sp_step_costs;
 
 /** @brief Append one row to energy.csv:
  *  step,t,dt,newton_its,n_cells,energy,bulk,gradient,repulsion,buffer,shape,
- *  seconds,assembly_s,factorisation_s,solves_s,supports_s,support_changed
+ *  seconds,assembly_s,factorisation_s,solves_s,supports_s,support_changed,
+ *  unknowns
  *  (@p seconds NULL: zeros) */
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,

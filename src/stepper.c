@@ -341,7 +341,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   /* the shape penalty's per-cell coefficients, refreshed before each step */
   const int shape_on = run->scene->shape.delta1 > 0 || run->scene->shape.delta2 > 0;
   sp_shape_coef *shape_coef = NULL;
-  sp_step_costs seconds = {0, 0, 0, 0, 0, 0}; /* of the step being attempted */
+  sp_step_costs seconds = {0}; /* of the step being attempted */
   double step_start = -1;
   int rc = SP_OK;
   while (rc == SP_OK && t < tc->t_end - t_tol && step < tc->max_steps) {
@@ -349,6 +349,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     const int n_cells = run->layout->n_cells;
     const size_t n_values = 2 * (size_t)run->layout->n_pairs;
     if ((long)n_values > sum->unknowns_max) sum->unknowns_max = (long)n_values;
+    seconds.unknowns = (long)n_values; /* of the attempt that is accepted */
     double dt_try = fmin(dt, tc->t_end - t);
     if (since_division >= 0) /* paper algorithm 2 after a division */
       dt_try = fmin(dt_try, sp_division_dt(tc->dt, dv->n_div, dv->m, since_division + 1));
@@ -450,7 +451,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     }
     seconds.step = wall_clock() - step_start;
     rc = record_energy(run, step, t, dt_try, report.newton_its, &seconds);
-    seconds = (sp_step_costs){0, 0, 0, 0, 0, 0};
+    seconds = (sp_step_costs){0};
     step_start = -1;
     if (rc != SP_OK) break;
     const int last = !(t < tc->t_end - t_tol && step < tc->max_steps);
@@ -531,7 +532,6 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   SP_ALLOC(run->divided_now, n);
   SP_CALL(sp_cells_initial_state(scene, run->mesh, run->layout, run->state));
   SP_CALL(renumber_rcb(run));
-  SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   /* the registry: every initial cell is born at t = 0 */
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            scene->division.observe_threshold, run->obs));
@@ -576,7 +576,12 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
     sp_layout_transfer(run->layout, run->state, layout, state, 0.0);
     SP_CALL(adopt_layout(run, layout, state));
     SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold, run->obs));
+  } else {
+    SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   }
+  /* (With local supports the solver sees only the local layout: the full
+   * one's graph couples every pair of cells at every node, N^2 x nodes
+   * entries, 20 GB for 256 cells on 84k nodes.) */
   run->division = (sp_division_params){
       .criterion = dv->criterion == SP_DIVIDE_BY_AGE ? SP_DIVIDE_AGE : SP_DIVIDE_MASS,
       .age = dv->t_div, .mass_ratio = dv->mass_ratio,

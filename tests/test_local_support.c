@@ -19,6 +19,7 @@
 #include "cells.h"
 #include "layout.h"
 #include "mesh.h"
+#include "output_read.h"
 
 /* The c of every cell at every node from the run's last fields_*.vtu is
  * not needed: the solutions are compared through cells.csv and energy.csv. */
@@ -244,6 +245,34 @@ int main(int argc, char **argv) {
   for (int k = 0; k < 4; ++k)
     CHECK(fabs(md[k] / (total / 4) - 1) < 0.1, "cell %d mass %g vs mean %g", k + 1, md[k],
           total / 4);
+  /* energy.csv logs the unknowns each step solved: the largest is the
+   * run's, they change only after a step that changed the supports, and
+   * with 4 cells on local supports they stay below the 4 x 2 x nodes of
+   * full supports (the full run of the same scene logs exactly that). */
+  csv_table e;
+  CHECK(csv_read("local_divide/energy.csv", &e) == 0 && e.n_rows > 2, "local_divide/energy.csv");
+  sp_mesh *mesh;
+  CHECK_OK(sp_mesh_from_scene(scene, &mesh));
+  long u_max = 0;
+  int u_changes = 0, bad_changes = 0;
+  for (int i = 1; i < e.n_rows; ++i) {
+    const long u = (long)at(&e, i, "unknowns");
+    if (u > u_max) u_max = u;
+    if (i > 1 && u != (long)at(&e, i - 1, "unknowns")) {
+      ++u_changes;
+      bad_changes += at(&e, i - 1, "support_changed") != 1;
+    }
+    CHECK(u > 0 && u % 2 == 0 && u <= 2L * 4 * mesh->n_nodes, "row %d: %ld unknowns", i, u);
+  }
+  printf("local_divide: unknowns change %d times, largest %ld (full with 4 cells: %d)\n",
+         u_changes, u_max, 2 * 4 * mesh->n_nodes);
+  CHECK(u_max == d.unknowns_max, "largest logged %ld, summary %ld", u_max, d.unknowns_max);
+  CHECK(u_changes >= d.divisions && bad_changes == 0,
+        "%d changes of the unknowns, %d not after a support change", u_changes, bad_changes);
+  CHECK(u_max < 2L * 4 * mesh->n_nodes / 2, "local supports: %ld unknowns of %d", u_max,
+        2 * 4 * mesh->n_nodes);
+  free(e.v);
+  sp_mesh_destroy(&mesh);
   sp_scene_destroy(&scene);
   MPI_Finalize();
   TEST_DONE();
