@@ -5,7 +5,8 @@
 # docs/img/paper/<run>/.
 #   bench/paper_runs.sh [--reuse] [run ...]
 #   runs: constant_volume_16 growth_12 embryo_8 growth_shape_12 (issue 4's run 4;
-#   with run 2 it prints the comparison of the two)
+#   with run 2 it prints the comparison of the two), and on request
+#   growth_shape_strong_12 (run 4 with the penalty dominating; added to the comparison)
 # --reuse: do not rerun a run whose out/paper/<run>/ and out/paper/<run>.log
 # exist (tables and pictures from that earlier run).
 set -euo pipefail
@@ -63,17 +64,34 @@ for run in "${runs[@]}"; do
   echo "   pictures: $(ls "$img" | tr '\n' ' ')"
 done
 
-# Run 4 against run 2 (issue 4): the energy and the packing at the end
+# Run 4 against run 2 (issue 4): the energy, the spikes at the divisions
+# and the packing at the end. Spike of a division at step S: height
+# (peak - e0) / e0 with e0 the energy of step S-1 and the peak the largest
+# energy before the next division; width: time from step S-1 until the
+# energy is back to e0 + half the height (">" if the next division came first).
 if [ -f out/paper/growth_12/cells.csv ] && [ -f out/paper/growth_shape_12/cells.csv ]; then
   echo "== run 4 (shape penalty) against run 2"
-  echo "   | run | cells | final energy (shape part) | largest energy | mean sqrt(I1/I2) | largest sqrt(I1/I2) |"
-  for run in growth_12 growth_shape_12; do
+  echo "   | run | cells | final energy (shape part) | largest energy | mean spike height | mean spike width | mean sqrt(I1/I2) | largest sqrt(I1/I2) |"
+  for run in growth_12 growth_shape_12 growth_shape_strong_12; do
     out=out/paper/$run
+    [ -f "$out/cells.csv" ] || continue
     e=$(awk -F, 'NR > 1 { last = $6; shape = $11; if ($6 > peak) peak = $6 } END { printf "%.4g (%.3g) | %.4g", last, shape, peak }' "$out/energy.csv")
+    spikes=$(awk -F, 'FNR == 1 { next }
+      FILENAME ~ /divisions/ { if (!($2 in div)) { div[$2] = 1; ds[++nd] = $2 } next }
+      { t[$1] = $2; en[$1] = $6; last = $1 }
+      END { for (i = 1; i <= nd; ++i) { s = ds[i]; e0 = en[s - 1]; stop = i < nd ? ds[i + 1] - 1 : last
+              peak = e0; at = s
+              for (j = s; j <= stop; ++j) if (en[j] > peak) { peak = en[j]; at = j }
+              w = -1
+              for (j = at; j <= stop; ++j) if (en[j] - e0 <= (peak - e0) / 2) { w = t[j] - t[s - 1]; break }
+              if (w < 0) { w = t[stop] - t[s - 1]; open++ }
+              h += (peak - e0) / e0; wsum += w }
+            printf "%.3g | %.3g%s", h / nd, wsum / nd, open ? sprintf(" (%d of %d >)", open, nd) : "" }' \
+      "$out/divisions.csv" "$out/energy.csv")
     a=$(awk -F, 'NR > 1 { last = $1; if ($8 > 0) r[$1, $3] = sqrt($7 / $8); n[$1] = $3 > n[$1] ? $3 : n[$1] }
       END { s = 0; m = 0; for (k = 1; k <= n[last]; ++k) { s += r[last, k]; if (r[last, k] > m) m = r[last, k] }
             printf "%d | %.3f | %.3f", n[last], s / n[last], m }' "$out/cells.csv")
     cells=${a%% *}
-    echo "   | $run | $cells | $e | ${a#* | } |"
+    echo "   | $run | $cells | $e | $spikes | ${a#* | } |"
   done
 fi

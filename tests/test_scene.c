@@ -6,7 +6,8 @@
  * - every file in tests/scenes/bad/ fails with SP_ERR_INPUT and a message
  *   containing the key named in its first line, "# expect: <key>";
  * - missing, unreadable and empty files fail the same way;
- * - docs/scene.md holds exactly the table sp_scene_print_keys prints. */
+ * - docs/scene.md holds exactly the table sp_scene_print_keys prints;
+ * - every scene shipped under inputs/ and inputs/paper/ loads. */
 #define _POSIX_C_SOURCE 200809L /* opendir, readdir */
 
 #include <dirent.h>
@@ -302,7 +303,36 @@ static void test_key_table_documented(void) {
   free(doc);
 }
 
+/* Every shipped scene is valid (a scene only a long run reads would
+ * otherwise break unseen). Returns the number loaded. */
+static int load_dir(const char *relative) {
+  char dir_path[PATH_SIZE], path[2 * PATH_SIZE + 2];
+  DIR *dir = opendir(source_path(relative, dir_path));
+  CHECK(dir != NULL, "cannot open %s", dir_path);
+  if (!dir) return 0;
+  int n = 0;
+  for (struct dirent *e; (e = readdir(dir));) {
+    const size_t len = strlen(e->d_name);
+    if (len < 6 || strcmp(e->d_name + len - 5, ".yaml") != 0) continue;
+    snprintf(path, sizeof path, "%s/%s", dir_path, e->d_name);
+    sp_scene *scene = NULL;
+    int rc = sp_scene_load(path, 0, NULL, &scene);
+    CHECK(rc == SP_OK && scene && scene->n_cells >= 1, "%s: rc %d: %s", path, rc,
+          sp_error_message());
+    if (rc == SP_OK) sp_scene_destroy(&scene);
+    ++n;
+  }
+  closedir(dir);
+  return n;
+}
+
+static void test_shipped_scenes(void) {
+  const int n = load_dir("inputs") + load_dir("inputs/paper");
+  CHECK(n >= 11, "only %d scenes under inputs/", n);
+}
+
 int main(void) {
+  test_shipped_scenes();
   test_defaults();
   test_every_key();
   test_overrides();
