@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Cost per step and per cell at a fixed number of cells (issue 7, "Scale"):
+# N just-born cells (radius 0.065, the aggregate's birth size) on a
+# hexagonal lattice of spacing 0.15, the N sites nearest the centre of the
+# 2 x 1 ellipse of inputs/aggregate_256.yaml (its mesh, model, supports and
+# solver), no source and no division, STEPS steps of DT. One run per N, one
+# process, OMP_NUM_THREADS=1. Complements bench/aggregate.sh (the growth
+# run, which outgrows this machine's memory before 256 cells): here every
+# N starts from the same kind of packing, so the per-cell cost is compared
+# at equal cell size.
+#   bench/packed_cost.sh [STEPS] [DT] [N ...]    (defaults: 3 2e-5 16 64 256)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+steps=${1:-3}
+dt=${2:-2e-5}
+shift 2 || shift $#
+sizes=("$@")
+[ ${#sizes[@]} -eq 0 ] && sizes=(16 64 256)
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+export OMP_NUM_THREADS=1
+t_end=$(awk -v n="$steps" -v dt="$dt" 'BEGIN { printf "%.17g", n * dt }')
+echo "packed cells on inputs/aggregate_256.yaml's mesh: $steps steps of dt = $dt"
+echo
+echo "| cells | unknowns | unknowns / node | Newton its | s/step | s/step/cell | s/iteration | assembly/it | factorisation/it | solves/it | peak MB | per cell vs first |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+ref=""
+for n in "${sizes[@]}"; do
+  # the scene without its cells, then n lattice sites nearest the centre
+  # whose disks keep 0.06 from the ellipse
+  awk '/^cells:/ { skip = 1; next } skip && /^  *-/ { next } { skip = 0; print }' \
+    inputs/aggregate_256.yaml > "$tmp/p$n.yaml"
+  echo "cells:" >> "$tmp/p$n.yaml"
+  awk -v n="$n" 'BEGIN { r = 0.065; h = 0.15; a = 2.0 - r - 0.06; b = 1.0 - r - 0.06
+      for (j = -10; j <= 10; ++j) for (i = -20; i <= 20; ++i) {
+        x = (i + (j % 2 ? 0.5 : 0)) * h; y = j * h * sqrt(3) / 2
+        if ((x / a) ^ 2 + (y / b) ^ 2 <= 1) printf "%.12f %.4f %.4f\n", x * x + 4 * y * y + 1e-9 * (i + 40 * j), x, y }
+    }' | sort -g > "$tmp/sites"
+  awk -v n="$n" 'NR <= n { printf "  - {x: %s, y: %s, radius: 0.065}\n", $2, $3 }' "$tmp/sites" \
+    >> "$tmp/p$n.yaml"
+  got=$(grep -c '^  - {x:' "$tmp/p$n.yaml")
+  [ "$got" -eq "$n" ] || { echo "only $got lattice sites fit for $n cells" >&2; exit 2; }
+  /usr/bin/time -f "%M" -o "$tmp/p$n.mem" build/softpack run "$tmp/p$n.yaml" --out "$tmp/o$n" \
+      --set division.criterion=none --set source.rate=0 --set time.dt="$dt" \
+      --set time.t_end="$t_end" --set output.pictures=false --set output.every=1000000 \
+      > "$tmp/p$n.log" 2>&1 || { echo "$n cells: run failed"; tail -5 "$tmp/p$n.log"; exit 1; }
+  nodes=$(grep -o 'NumberOfPoints="[0-9]*"' "$tmp/o$n/fields_000000.vtu" | head -1 | tr -dc 0-9)
+  row=$(awk -F, -v n="$n" -v nodes="$nodes" -v mem="$(cat "$tmp/p$n.mem")" -v ref="$ref" \
+    'NR == 1 { for (j = 1; j <= NF; ++j) c[$j] = j; next }
+     $1 > 0 { k++; its += $c["newton_its"]; sec += $c["seconds"]; as += $c["assembly_s"]
+              fa += $c["factorisation_s"]; so += $c["solves_s"]
+              if ($c["unknowns"] > u) u = $c["unknowns"] }
+     END { per = sec / k / n
+           printf "%.6g|| %d | %d | %.2f | %d | %.3f | %.4f | %.3f | %.3f | %.3f | %.3f | %.0f | %s |\n",
+             per, n, u, u / nodes, its, sec / k, per, sec / its, as / its, fa / its, so / its,
+             mem / 1024, ref ? sprintf("%.2f", per / ref) : "1.00" }' "$tmp/o$n/energy.csv")
+  [ -z "$ref" ] && ref=${row%%||*}
+  echo "|${row#*||}"
+done
