@@ -7,7 +7,9 @@
 # asks for a small multiple of 2), seconds per step and per step per cell,
 # seconds per Newton iteration and its phases, and the per-cell cost
 # against the 16-cell stage. Copies the last pictures with 16, 64 and 256
-# cells and the energy curve to docs/img/aggregate_256/.
+# cells and the energy curve to docs/img/aggregate_256/. On a 24 GB machine
+# the run reaches 64 cells and needs ~20 GB at 128 (docs/local-support.md):
+# stop it there; the tables come from what energy.csv holds (--reuse).
 #   bench/aggregate.sh [--reuse]    (--reuse: tables and pictures of an earlier run)
 #   NP=2 bench/aggregate.sh         (under mpirun -np 2)
 set -euo pipefail
