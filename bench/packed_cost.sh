@@ -5,9 +5,9 @@
 # 2 x 1 ellipse of inputs/aggregate_256.yaml (its mesh, model, supports and
 # solver), no source and no division, STEPS steps of DT. One run per N, one
 # process, OMP_NUM_THREADS=1. Complements bench/aggregate.sh (the growth
-# run, which outgrows this machine's memory before 256 cells): here every
-# N starts from the same kind of packing, so the per-cell cost is compared
-# at equal cell size.
+# run, whose stages differ in cell sizes, iterations and failed attempts):
+# here every N starts from the same kind of packing, so the per-cell cost
+# is compared at equal cell size and equal work per step.
 #   bench/packed_cost.sh [STEPS] [DT] [N ...]    (defaults: 3 2e-5 16 64 256)
 set -euo pipefail
 cd "$(dirname "$0")/.."
