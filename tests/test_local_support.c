@@ -21,43 +21,39 @@
 #include "mesh.h"
 #include "output_read.h"
 
-/* The c of every cell at every node from the run's last fields_*.vtu is
- * not needed: the solutions are compared through cells.csv and energy.csv. */
-static int read_last_cells(const char *path, int n_cells, double *mass, double *xc, double *yc) {
-  FILE *f = fopen(path, "r");
-  if (!f) return 0;
-  char line[1024];
+/* The solutions are compared through cells.csv and energy.csv
+ * (output_read.h), not the nodal fields. */
+
+/** Mass and centre of cells 1..n_cells at @p step of cells.csv (step < 0:
+ *  the last step); returns the number of rows read. */
+static int cells_at_step(const char *path, int step, int n_cells, double *mass, double *xc,
+                         double *yc) {
+  csv_table t;
   int rows = 0;
-  if (!fgets(line, sizeof line, f)) { fclose(f); return 0; }
-  while (fgets(line, sizeof line, f)) {
-    int step, cell;
-    double t, m, x, y;
-    if (sscanf(line, "%d,%lf,%d,%lf,%lf,%lf", &step, &t, &cell, &m, &x, &y) == 6 &&
-        cell >= 1 && cell <= n_cells) {
-      mass[cell - 1] = m;
-      xc[cell - 1] = x;
-      yc[cell - 1] = y;
+  if (csv_read(path, &t) == 0 && t.n_rows > 0) {
+    if (step < 0) step = (int)at(&t, t.n_rows - 1, "step");
+    for (int i = 0; i < t.n_rows; ++i) {
+      const int cell = (int)at(&t, i, "cell");
+      if ((int)at(&t, i, "step") != step || cell < 1 || cell > n_cells) continue;
+      mass[cell - 1] = at(&t, i, "mass");
+      xc[cell - 1] = at(&t, i, "xc");
+      yc[cell - 1] = at(&t, i, "yc");
       ++rows;
     }
   }
-  fclose(f);
+  free(t.v);
   return rows;
 }
 
+/** The last energy of energy.csv (NAN if unreadable), the first in *first. */
 static double first_and_last_energy(const char *path, double *first) {
-  FILE *f = fopen(path, "r");
-  char line[1024];
+  csv_table t;
   double e = NAN;
-  int row = 0;
-  if (!f) return NAN;
-  if (!fgets(line, sizeof line, f)) { fclose(f); return NAN; }
-  while (fgets(line, sizeof line, f)) {
-    int step, its, n;
-    double t, dt;
-    if (sscanf(line, "%d,%lf,%lf,%d,%d,%lf", &step, &t, &dt, &its, &n, &e) == 6 && row++ == 0)
-      *first = e;
+  if (csv_read(path, &t) == 0 && t.n_rows > 0) {
+    *first = at(&t, 0, "energy");
+    e = at(&t, t.n_rows - 1, "energy");
   }
-  fclose(f);
+  free(t.v);
   return e;
 }
 
@@ -176,8 +172,8 @@ int main(int argc, char **argv) {
   sp_run_summary l = run("local_short.yaml", 2, wide_set, "local_ref_local");
   sp_run_summary l20 = run("local_short.yaml", 0, NULL, "local_ref_local20");
   double mf[2], xf[2], yf[2], ml[2], xl[2], yl[2], e0f, e0l;
-  CHECK(read_last_cells("local_ref_full/cells.csv", 2, mf, xf, yf) > 0, "full cells.csv");
-  CHECK(read_last_cells("local_ref_local/cells.csv", 2, ml, xl, yl) > 0, "local cells.csv");
+  CHECK(cells_at_step("local_ref_full/cells.csv", -1, 2, mf, xf, yf) > 0, "full cells.csv");
+  CHECK(cells_at_step("local_ref_local/cells.csv", -1, 2, ml, xl, yl) > 0, "local cells.csv");
   double ef = first_and_last_energy("local_ref_full/energy.csv", &e0f);
   double el = first_and_last_energy("local_ref_local/energy.csv", &e0l);
   double e0l20, el20 = first_and_last_energy("local_ref_local20/energy.csv", &e0l20);
@@ -198,20 +194,9 @@ int main(int argc, char **argv) {
 
   /* 2. a pushed cell's support follows it; masses kept */
   sp_run_summary p = run("local_push.yaml", 0, NULL, "local_push");
-  double m1[2], x1[2], y1[2];
-  double e0 = 0;
-  first_and_last_energy("local_push/energy.csv", &e0);
-  FILE *fc = fopen("local_push/cells.csv", "r");
-  double m0[2] = {0, 0}, x0[2] = {0, 0};
-  char line[1024];
-  if (fc && fgets(line, sizeof line, fc))
-    for (int i = 0; i < 2 && fgets(line, sizeof line, fc); ++i) {
-      int step, cell;
-      double t, y;
-      sscanf(line, "%d,%lf,%d,%lf,%lf,%lf", &step, &t, &cell, &m0[i], &x0[i], &y);
-    }
-  if (fc) fclose(fc);
-  read_last_cells("local_push/cells.csv", 2, m1, x1, y1);
+  double m0[2] = {0, 0}, x0[2] = {0, 0}, y0[2], m1[2], x1[2], y1[2];
+  cells_at_step("local_push/cells.csv", 0, 2, m0, x0, y0);
+  cells_at_step("local_push/cells.csv", -1, 2, m1, x1, y1);
   printf("pushed cell: x %.4f -> %.4f, %d support changes, mass %.15g -> %.15g; largest mass "
          "change restored %.2e, largest energy rise at a change %.2e\n", x0[1], x1[1],
          p.layout_changes, m0[1], m1[1], p.support_mass_correction, p.support_energy_rise);
@@ -240,7 +225,7 @@ int main(int argc, char **argv) {
          d.support_energy_rise);
   CHECK(d.n_cells == 4 && d.divisions == 3, "%d cells, %d divisions", d.n_cells, d.divisions);
   double md[4], xd[4], yd[4];
-  read_last_cells("local_divide/cells.csv", 4, md, xd, yd);
+  cells_at_step("local_divide/cells.csv", -1, 4, md, xd, yd);
   double total = md[0] + md[1] + md[2] + md[3];
   for (int k = 0; k < 4; ++k)
     CHECK(fabs(md[k] / (total / 4) - 1) < 0.1, "cell %d mass %g vs mean %g", k + 1, md[k],
