@@ -107,16 +107,29 @@ static void core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
   }
 }
 
-/** Energy and observables rows of the current state (run->obs must be the
- *  observables of run->state: every change of the state refreshes them). */
-static int record_energy(sp_run *run, int step, double t, double dt, int its,
-                         const sp_step_costs *seconds) {
-  sp_energy_parts parts;
-  if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
+/** The energy parts of the fields (without the shape term) of the run's state. */
+static int state_energy(sp_run *run, sp_energy_parts *parts) {
+  if (sp_solver_energy(run->solver, &run->model, run->state, parts) != 0)
     return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
+  return SP_OK;
+}
+
+static double field_total(const sp_energy_parts *p) {
+  return p->bulk + p->gradient + p->repulsion + p->buffer;
+}
+
+/** Energy and observables rows of the current state (run->obs must be the
+ *  observables of run->state: every change of the state refreshes them).
+ *  @p known: the field energy of this state if already computed (NULL:
+ *  computed here). */
+static int record_energy(sp_run *run, int step, double t, double dt, int its,
+                         const sp_step_costs *seconds, const sp_energy_parts *known) {
+  sp_energy_parts parts;
+  if (known) parts = *known;
+  else SP_CALL(state_energy(run, &parts));
   const double shape = sp_shape_energy(run->layout->n_cells, run->obs, run->birth,
                                        run->scene->shape.delta1, run->scene->shape.delta2);
-  const double total = parts.bulk + parts.gradient + parts.repulsion + parts.buffer + shape;
+  const double total = field_total(&parts) + shape;
   if (run->n_energy == run->cap_energy) {
     int cap = run->cap_energy ? 2 * run->cap_energy : 1024;
     double *t_new = realloc(run->energy_t, cap * sizeof(double));
@@ -172,15 +185,6 @@ static int grow_array(void **ptr, size_t elem, int n_old, int n) {
   return SP_OK;
 }
 
-/** The energy of the fields (without the shape term) of the run's state. */
-static int field_energy(sp_run *run, double *energy) {
-  sp_energy_parts parts;
-  if (sp_solver_energy(run->solver, &run->model, run->state, &parts) != 0)
-    return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
-  *energy = parts.bulk + parts.gradient + parts.repulsion + parts.buffer;
-  return SP_OK;
-}
-
 /** Make (layout, state) the run's own, resize the per-pair buffers and
  *  hand the layout to the solver. */
 static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
@@ -196,23 +200,26 @@ static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
 }
 
 /** Local supports: recompute every support from the fields (they follow
- *  the cells), keeping each cell's mass exactly. */
-static int update_supports(sp_run *run) {
+ *  the cells), keeping each cell's mass exactly. @p after: the field
+ *  energy of the new state (for the energy row of the step). */
+static int update_supports(sp_run *run, sp_energy_parts *after) {
   const double t0 = wall_clock();
   sp_layout *layout;
-  double *state, correction, e_before = 0, e_after = 0;
-  SP_CALL(field_energy(run, &e_before));
+  double *state, correction;
+  sp_energy_parts before;
+  SP_CALL(state_energy(run, &before));
   const int always = run->scene->layout.shrink == SP_SHRINK_ALWAYS;
   SP_CALL(sp_support_rebuild(run->support, run->layout, run->state,
                              always ? NULL : run->divided_now, &layout, &state, &correction));
   memset(run->divided_now, 0, (size_t)run->layout->n_cells);
   SP_CALL(adopt_layout(run, layout, state));
-  SP_CALL(field_energy(run, &e_after));
+  SP_CALL(state_energy(run, after));
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            run->scene->division.observe_threshold, run->obs));
   run->sum->layout_changes += 1;
   if (correction > run->sum->support_mass_correction) run->sum->support_mass_correction = correction;
-  const double rise = (e_after - e_before) / fabs(e_before);
+  const double e_before = field_total(&before);
+  const double rise = (field_total(after) - e_before) / fabs(e_before);
   if (rise > run->sum->support_energy_rise) run->sum->support_energy_rise = rise;
   run->sum->t_layout += wall_clock() - t0;
   return SP_OK;
@@ -335,7 +342,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   int since_division = -1; /* steps since the last division; -1: none yet */
   double *core_mass_old = NULL;
   sum->dt_smallest = tc->dt;
-  SP_CALL(record_energy(run, 0, t, 0.0, 0, NULL));
+  SP_CALL(record_energy(run, 0, t, 0.0, 0, NULL, NULL));
   SP_CALL(write_snapshot(run, 0, t));
   const double t_tol = 1e-12 * tc->t_end;
   /* the shape penalty's per-cell coefficients, refreshed before each step */
@@ -424,13 +431,15 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     for (int k = 0; k < n_cells; ++k) core_mass_old[k] = run->obs[k].mass_core;
     rc = sp_cells_observe(run->mesh, run->layout, run->state,
                           run->scene->division.observe_threshold, run->obs);
-    int n_divided = 0;
+    int n_divided = 0, have_energy = 0;
+    sp_energy_parts energy_after_supports;
     if (rc == SP_OK) rc = divide_due_cells(run, t_old, t, step, core_mass_old, &n_divided);
     if (rc != SP_OK) break;
     if (rc == SP_OK && run->support &&
         (n_divided || sp_support_needs_update(run->support, run->layout, run->state))) {
       const double t_layout = run->sum->t_layout;
-      rc = update_supports(run);
+      rc = update_supports(run, &energy_after_supports);
+      have_energy = rc == SP_OK;
       seconds.supports = run->sum->t_layout - t_layout;
       seconds.support_changed = 1;
     }
@@ -450,7 +459,9 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       if (rc != SP_OK) break;
     }
     seconds.step = wall_clock() - step_start;
-    rc = record_energy(run, step, t, dt_try, report.newton_its, &seconds);
+    /* the state is the one update_supports left, if it ran */
+    rc = record_energy(run, step, t, dt_try, report.newton_its, &seconds,
+                       have_energy ? &energy_after_supports : NULL);
     seconds = (sp_step_costs){0};
     step_start = -1;
     if (rc != SP_OK) break;
