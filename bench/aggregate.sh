@@ -17,6 +17,7 @@
 #   OUT=dir IMG=dir bench/aggregate.sh --reuse   (another run's outputs, pictures elsewhere)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib.sh
 scene=inputs/aggregate_256.yaml
 out=${OUT:-out/aggregate_256}
 img=${IMG:-docs/img/aggregate_256}
@@ -61,13 +62,5 @@ awk -F, -v nodes="$nodes" 'NR == 1 { for (j = 1; j <= NF; ++j) c[$j] = j; next }
   "$out/energy.csv"
 echo
 echo "(steps with N cells include the ramp of algorithm 2 after each division: tiny steps of 2-3 iterations)"
-mkdir -p "$img"
-[ -f "$out/energy.png" ] && cp "$out/energy.png" "$img/energy.png"
-awk -F, 'NR > 1 { print $1, $5 }' "$out/energy.csv" > "$out/cells_per_step.txt"
-for png in "$out"/cells_*.png; do
-  [ -e "$png" ] || continue
-  step=$(basename "$png" .png | sed 's/cells_0*//'); step=${step:-0}
-  n=$(awk -v s="$step" '$1 == s { print $2 }' "$out/cells_per_step.txt")
-  case "$n" in 16|64|128|256) cp "$png" "$img/cells_$(printf %03d "$n").png" ;; esac
-done
+stage_pictures "$out" "$img" 3 16 64 128 256
 echo "pictures: $(ls "$img" | tr '\n' ' ')"

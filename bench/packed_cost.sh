@@ -11,6 +11,7 @@
 #   bench/packed_cost.sh [STEPS] [DT] [N ...]    (defaults: 3 2e-5 16 64 256)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib.sh
 steps=${1:-3}
 dt=${2:-2e-5}
 shift 2 || shift $#
@@ -28,8 +29,7 @@ ref=""
 for n in "${sizes[@]}"; do
   # the scene without its cells, then n lattice sites nearest the centre
   # whose disks keep 0.06 from the ellipse
-  awk '/^cells:/ { skip = 1; next } skip && /^  *-/ { next } { skip = 0; print }' \
-    inputs/aggregate_256.yaml > "$tmp/p$n.yaml"
+  scene_without_cells inputs/aggregate_256.yaml > "$tmp/p$n.yaml"
   echo "cells:" >> "$tmp/p$n.yaml"
   awk -v n="$n" 'BEGIN { r = 0.065; h = 0.15; a = 2.0 - r - 0.06; b = 1.0 - r - 0.06
       for (j = -10; j <= 10; ++j) for (i = -20; i <= 20; ++i) {

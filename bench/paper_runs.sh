@@ -11,6 +11,7 @@
 # exist (tables and pictures from that earlier run).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib.sh
 reuse=0
 [ "${1:-}" = "--reuse" ] && { reuse=1; shift; }
 runs=("$@")
@@ -53,14 +54,8 @@ for run in "${runs[@]}"; do
   awk -F, 'NR > 1 { printf "     %.5f  %4d  %2d -> %2d  %+.3f\n", $1, $2, $3, $4, $5 }' "$out/divisions.csv"
   # pictures at each stage
   img=docs/img/paper/$run
-  rm -rf "$img" && mkdir -p "$img"
-  cp "$out/energy.png" "$img/energy.png"
-  awk -F, 'NR > 1 { print $1, $5 }' "$out/energy.csv" > "$out/cells_per_step.txt"
-  for png in "$out"/cells_*.png; do
-    step=$(basename "$png" .png | sed 's/cells_0*//'); step=${step:-0}
-    n=$(awk -v s="$step" '$1 == s { print $2 }' "$out/cells_per_step.txt")
-    cp "$png" "$img/cells_$(printf %02d "$n").png"   # later pictures overwrite: the last with n cells
-  done
+  rm -rf "$img"
+  stage_pictures "$out" "$img" 2
   echo "   pictures: $(ls "$img" | tr '\n' ' ')"
 done
 

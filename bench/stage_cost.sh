@@ -11,6 +11,7 @@
 #   (defaults: out/paper/constant_volume_16 inputs/paper/constant_volume_16.yaml 3 2e-5, last step)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib.sh
 run_dir=${1:-out/paper/constant_volume_16}
 scene=${2:-inputs/paper/constant_volume_16.yaml}
 steps=${3:-3}
@@ -21,7 +22,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # the scene without its cells, then the cells of that step (radius from the
 # core mass, shrunk by 0.9 so every disk lies inside the domain)
-awk '/^cells:/ { skip = 1; next } skip && /^  *-/ { next } { skip = 0; print }' "$scene" > "$tmp/stage.yaml"
+scene_without_cells "$scene" > "$tmp/stage.yaml"
 echo "cells:" >> "$tmp/stage.yaml"
 awk -F, -v s="$step" 'NR > 1 && $1 == s {
     printf "  - {x: %.6f, y: %.6f, radius: %.6f}\n", $5, $6, 0.9 * sqrt($10 / 3.141592653589793) }' \
