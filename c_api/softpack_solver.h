@@ -76,13 +76,23 @@ typedef struct {
 } sp_model_params;
 
 /**
- * Explicit shape-penalty data of one cell (MODEL.md, shape penalty): the term
- * adds -sum_i coef_i * (v_i . Ibar(X) v_i) to mu_k, Ibar about (xc, yc).
+ * Shape-penalty data of one cell (MODEL.md, shape penalty): the term adds
+ * -sum_i coef_i * (v_i . Ibar(X) v_i) to mu_k, Ibar about (xc, yc).
+ *
+ * Explicit (sp_step_data.shape_implicit = 0): coef as given, from c^n.
+ * Linearised implicit (shape_implicit = 1): with the centre, eigenvectors
+ * and mask frozen at c^n, the moments of the new state are
+ * I_j = I_j^n + dI_j, dI_j = int_mask Ihat_j (c - c^n) (exact to first
+ * order: the centre's shift does not move central moments at first order),
+ * and the term uses coef_i - sum_j gain[i][j] dI_j. Its Jacobian adds, per
+ * cell, u_i gain[i][j] u_j^T (u_i = int_mask Ihat_i N: rank two per cell),
+ * applied by Sherman-Morrison-Woodbury on the sparse factorisation.
  */
 typedef struct {
   double xc, yc;
   double v[2][2];  /**< unit eigenvectors v_1 (larger moment), v_2 */
   double coef[2];  /**< 2 delta^i (I^i,ref - I^i) */
+  double gain[2][2]; /**< -d coef_i / d I_j (implicit only; 0: none) */
   double threshold; /**< the term acts only where c^n >= threshold (at the
                          quadrature point), as the observables count c only
                          where c >= their weight threshold */
@@ -95,6 +105,8 @@ typedef struct {
   const double *state_old;  /**< c^n (and mu^n) in layout order */
   const double *source;     /**< per pair: nodal source s_k (NULL: none) */
   const sp_shape_coef *shape; /**< per cell (NULL: no shape term) */
+  int shape_implicit;         /**< 1: shape coefficients follow the new
+                                   state's moments through gain */
 } sp_step_data;
 
 /** What a step did. */

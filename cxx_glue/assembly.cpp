@@ -342,6 +342,31 @@ double Assembly::compare_jacobians(const sp_step_data &d, const double *state, i
   return global;
 }
 
+void Assembly::shape_weights(const sp_step_data &d, std::vector<double> &u) const {
+  std::vector<double> mine(2 * (size_t)n_pairs_, 0.0);
+  for (int e : my_elems_) {
+    const ElementGeometry &geo = geometry_[e];
+    const int nc = n_cells_on(e), s0 = elem_start_[e];
+    for (int j = 0; j < nc; ++j) {
+      const sp_shape_coef &sc = d.shape[slot_cell_[s0 + j]];
+      const int *pairs = &slot_pair_[4 * (s0 + j)];
+      for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+        double c_old = 0.0;
+        for (int a = 0; a < 4; ++a) c_old += geo.N[q][a] * d.state_old[2 * pairs[a]];
+        if (c_old < sc.threshold) continue;  // the mask of element_residual
+        const double xb = geo.x[q][0] - sc.xc, yb = geo.x[q][1] - sc.yc;
+        for (int i = 0; i < 2; ++i) {
+          const double ihat = shape_ihat(sc.v[i], xb, yb);
+          for (int a = 0; a < 4; ++a) mine[2 * pairs[a] + i] += geo.w[q] * geo.N[q][a] * ihat;
+        }
+      }
+    }
+  }
+  u.resize(mine.size());
+  if (comm_.SumAll(mine.data(), u.data(), (int)mine.size()) != 0)
+    throw std::runtime_error("shape weights: reduction failed");
+}
+
 void Assembly::element_pass(const sp_step_data &d, const double *state, int kind) const {
   Gathered g;
   std::vector<double> R, K;

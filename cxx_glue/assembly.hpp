@@ -29,6 +29,7 @@ class Assembly {
   const Epetra_Map &map() const { return *map_; }
   const Epetra_CrsGraph &graph() const { return *graph_; }
   int n_dofs() const { return 2 * n_pairs_; }
+  int n_cells() const { return n_cells_; }
 
   // Residual F (owned rows of map()) at the full (replicated) state.
   void residual(const sp_step_data &data, const double *state, Epetra_Vector &F) const;
@@ -43,6 +44,13 @@ class Assembly {
   // Jacobians of two kinds, over the entries of present unknowns (reduced).
   double compare_jacobians(const sp_step_data &data, const double *state, int kind_a,
                            int kind_b) const;
+  // The shape term's weights of every pair p (replicated, reduced over the
+  // ranks): u[2p + i] = int N_p Ihat_i over the quadrature points where
+  // c^n >= the cell's threshold, Ihat_i about the cell's frozen centre and
+  // eigenvector i (data.shape). The term's rows in mu are -coef_i u_i, and
+  // int_mask Ihat_i c = sum_p u[2p + i] c_p for any c of the layout.
+  void shape_weights(const sp_step_data &data, std::vector<double> &u) const;
+  int pair_cell(int p) const { return pair_cell_[p]; }
   // Gathers and computes every element matrix of this rank without adding
   // them into a matrix (the element kernel alone, for timing).
   void element_pass(const sp_step_data &data, const double *state, int kind) const;

@@ -52,7 +52,7 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
  public:
   DirectLinearSystem(Solver &s, StepInterface &i) : s_(s), i_(i) {}
   bool applyJacobian(const NOX::Epetra::Vector &in, NOX::Epetra::Vector &out) const override {
-    return s_.jacobian_matrix->Apply(in.getEpetraVector(), out.getEpetraVector()) == 0;
+    return s_.apply_jacobian(in.getEpetraVector(), out.getEpetraVector());
   }
   bool applyJacobianTranspose(const NOX::Epetra::Vector &in,
                               NOX::Epetra::Vector &out) const override {
@@ -231,19 +231,180 @@ void Solver::gather(const Epetra_Vector &x, std::vector<double> &full) const {
                  MPI_DOUBLE, comm_.Comm());
 }
 
+namespace {
+bool agree(MPI_Comm comm, bool ok, std::string &why);
+}  // namespace
+
 void Solver::fill_residual(const sp_step_data &d, const Epetra_Vector &x, Epetra_Vector &F) {
   double t0 = now();
   gather(x, full_);
-  assembly_->residual(d, full_.data(), F);
+  assembly_->residual(data_at(d, full_.data()), full_.data(), F);
   t_assembly += now() - t0;
 }
 
 void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
   double t0 = now();
   gather(x, full_);
-  assembly_->jacobian(d, full_.data(), options_.jacobian, *jacobian_matrix);
+  // The element Jacobians take the coefficients as constants; their
+  // dependence on the moments is the low-rank part (factor_low_rank).
+  assembly_->jacobian(data_at(d, full_.data()), full_.data(), options_.jacobian,
+                      *jacobian_matrix);
   jacobian_fresh_ = true;
   t_assembly += now() - t0;
+}
+
+void Solver::prepare_shape(const sp_step_data &d) {
+  shape_u_.clear();
+  shape_coef_.clear();
+  active_of_cell_.clear();
+  active_gain_.clear();
+  row_active_.clear();
+  woodbury_lu_.clear();
+  if (!d.shape || !d.shape_implicit) return;
+  const int n_cells = assembly_->n_cells();
+  active_of_cell_.assign(n_cells, -1);
+  int n_active = 0;
+  for (int k = 0; k < n_cells; ++k) {
+    const sp_shape_coef &sc = d.shape[k];
+    bool any = false;
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) {
+        if (!std::isfinite(sc.gain[i][j]))
+          throw std::runtime_error("shape: gain of cell " + std::to_string(k) + " is not finite");
+        any = any || sc.gain[i][j] != 0.0;
+      }
+    if (!any) continue;
+    active_of_cell_[k] = n_active++;
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) active_gain_.push_back(-sc.gain[i][j]);
+  }
+  shape_coef_.assign(d.shape, d.shape + n_cells);
+  shape_data_ = d;
+  shape_data_.shape = shape_coef_.data();
+  if (n_active == 0) return;
+  assembly_->shape_weights(d, shape_u_);
+  const Epetra_Map &map = assembly_->map();
+  row_active_.assign(map.NumMyElements(), -1);
+  for (int r = 0; r < map.NumMyElements(); ++r)
+    row_active_[r] = active_of_cell_[assembly_->pair_cell(map.GID(r) / 2)];
+}
+
+const sp_step_data &Solver::data_at(const sp_step_data &d, const double *state) {
+  if (shape_coef_.empty()) return d;
+  // dI_j = int_mask Ihat_j (c - c^n) per cell, from the replicated state.
+  const int n_cells = (int)shape_coef_.size();
+  std::vector<double> dI(2 * (size_t)n_cells, 0.0);
+  if (!shape_u_.empty())
+    for (int p = 0; p < assembly_->n_dofs() / 2; ++p) {
+      const int k = assembly_->pair_cell(p);
+      if (active_of_cell_[k] < 0) continue;
+      const double dc = state[2 * p] - d.state_old[2 * p];
+      dI[2 * k] += shape_u_[2 * p] * dc;
+      dI[2 * k + 1] += shape_u_[2 * p + 1] * dc;
+    }
+  for (int k = 0; k < n_cells; ++k)
+    for (int i = 0; i < 2; ++i)
+      shape_coef_[k].coef[i] = d.shape[k].coef[i] - d.shape[k].gain[i][0] * dI[2 * k] -
+                               d.shape[k].gain[i][1] * dI[2 * k + 1];
+  return shape_data_;
+}
+
+void Solver::low_rank_dots(const double *x, int f, std::vector<double> &t) const {
+  const Epetra_Map &map = assembly_->map();
+  std::vector<double> mine(active_gain_.size() / 2, 0.0);
+  for (int r = 0; r < (int)row_active_.size(); ++r) {
+    const int a = row_active_[r], g = map.GID(r);
+    if (a < 0 || g % 2 != f) continue;
+    mine[2 * a] += shape_u_[g - f] * x[r];
+    mine[2 * a + 1] += shape_u_[g - f + 1] * x[r];
+  }
+  t.resize(mine.size());
+  MPI_Allreduce(mine.data(), t.data(), (int)mine.size(), MPI_DOUBLE, MPI_SUM, comm_.Comm());
+}
+
+void Solver::low_rank_add(const std::vector<double> &w, int f, double *x) const {
+  const Epetra_Map &map = assembly_->map();
+  for (int r = 0; r < (int)row_active_.size(); ++r) {
+    const int a = row_active_[r], g = map.GID(r);
+    if (a < 0 || g % 2 != f) continue;
+    x[r] += shape_u_[g - f] * w[2 * a] + shape_u_[g - f + 1] * w[2 * a + 1];
+  }
+}
+
+namespace {
+
+// C t per active cell: (C t)[2a + i] = sum_j gain_a[i][j] t[2a + j].
+std::vector<double> times_gain(const std::vector<double> &gain, const std::vector<double> &t) {
+  std::vector<double> out(t.size());
+  for (size_t a = 0; 2 * a < t.size(); ++a)
+    for (int i = 0; i < 2; ++i)
+      out[2 * a + i] = gain[4 * a + 2 * i] * t[2 * a] + gain[4 * a + 2 * i + 1] * t[2 * a + 1];
+  return out;
+}
+
+}  // namespace
+
+// The Jacobian is A + U C V^T: A the sparse (element) part, U's columns the
+// shape weights u_i of an active cell on its mu rows, V's the same on its c
+// rows, C = -gain per cell (R_mu holds +coef_i u_i, and coef_i falls by
+// gain[i][j] dI_j). Woodbury: x = y - A^-1 U w with y = A^-1 b and
+// (I + C V^T A^-1 U) w = C V^T y. K = I + C V^T A^-1 U costs 2 solves per
+// active cell per factorisation (counted in t_solve) and is LU-factored
+// here, identically on every rank.
+bool Solver::factor_low_rank(std::string &why) {
+  const int m = (int)active_gain_.size() / 2;
+  const int n = (int)row_active_.size();
+  std::vector<double> S((size_t)m * m), col(m, 0.0), b(n), z(n), t;
+  double t0 = now();
+  for (int c = 0; c < m; ++c) {
+    std::fill(b.begin(), b.end(), 0.0);
+    std::fill(col.begin(), col.end(), 0.0);
+    col[c] = 1.0;
+    low_rank_add(col, 1, b.data());
+    bool ok = direct_->solve(b.data(), z.data(), why);
+    if (!agree(comm_.Comm(), ok, why)) return false;
+    low_rank_dots(z.data(), 0, t);
+    for (int r = 0; r < m; ++r) S[(size_t)r * m + c] = t[r];
+  }
+  t_solve += now() - t0;
+  // K = I + C S, row r = 2a + i: sum_j gain_a[i][j] S[2a + j][.]
+  woodbury_lu_.assign((size_t)m * m, 0.0);
+  for (int r = 0; r < m; ++r) {
+    const int a = r / 2, i = r % 2;
+    for (int c = 0; c < m; ++c)
+      woodbury_lu_[(size_t)r * m + c] = (r == c ? 1.0 : 0.0) +
+                                        active_gain_[4 * a + 2 * i] * S[(size_t)(2 * a) * m + c] +
+                                        active_gain_[4 * a + 2 * i + 1] * S[(size_t)(2 * a + 1) * m + c];
+  }
+  // LU with partial pivoting (small and dense: 2 per active cell).
+  woodbury_piv_.assign(m, 0);
+  double *K = woodbury_lu_.data();
+  for (int k = 0; k < m; ++k) {
+    int p = k;
+    for (int r = k + 1; r < m; ++r)
+      if (std::fabs(K[(size_t)r * m + k]) > std::fabs(K[(size_t)p * m + k])) p = r;
+    woodbury_piv_[k] = p;
+    if (!(std::fabs(K[(size_t)p * m + k]) > 0) || !std::isfinite(K[(size_t)p * m + k])) {
+      why = "shape term: the Woodbury matrix is singular";
+      return false;
+    }
+    if (p != k)
+      for (int c = 0; c < m; ++c) std::swap(K[(size_t)k * m + c], K[(size_t)p * m + c]);
+    for (int r = k + 1; r < m; ++r) {
+      const double l = K[(size_t)r * m + k] /= K[(size_t)k * m + k];
+      for (int c = k + 1; c < m; ++c) K[(size_t)r * m + c] -= l * K[(size_t)k * m + c];
+    }
+  }
+  return true;
+}
+
+bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out) {
+  if (jacobian_matrix->Apply(in, out) != 0) return false;
+  if (shape_u_.empty()) return true;
+  std::vector<double> t;
+  low_rank_dots(in.Values(), 0, t);
+  low_rank_add(times_gain(active_gain_, t), 1, out.Values());
+  return true;
 }
 
 namespace {
@@ -270,6 +431,7 @@ bool agree(MPI_Comm comm, bool ok, std::string &why) {
 }  // namespace
 
 bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
+  const bool low_rank = !shape_u_.empty();
   if (jacobian_fresh_) {
     double t0 = now();
     const int n = (int)csr_ptr_.size() - 1;
@@ -295,10 +457,35 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
     }
     pattern_changed_ = false;
     jacobian_fresh_ = false;
+    if (low_rank && !factor_low_rank(why)) {
+      pattern_changed_ = true;
+      jacobian_fresh_ = true;  // K is stale: refactor before the next solve
+      return false;
+    }
   }
   double t0 = now();
   bool ok = direct_->solve(b.Values(), x.Values(), why);
   ok = agree(comm_.Comm(), ok, why);
+  if (ok && low_rank) {
+    // w = K^-1 C V^T y, then x -= A^-1 U w
+    std::vector<double> t;
+    low_rank_dots(x.Values(), 0, t);
+    std::vector<double> w = times_gain(active_gain_, t);
+    const int m = (int)w.size();
+    const double *K = woodbury_lu_.data();
+    for (int k = 0; k < m; ++k) std::swap(w[k], w[woodbury_piv_[k]]);
+    for (int r = 0; r < m; ++r)
+      for (int c = 0; c < r; ++c) w[r] -= K[(size_t)r * m + c] * w[c];
+    for (int r = m - 1; r >= 0; --r) {
+      for (int c = r + 1; c < m; ++c) w[r] -= K[(size_t)r * m + c] * w[c];
+      w[r] /= K[(size_t)r * m + r];
+    }
+    std::vector<double> rhs(x.MyLength(), 0.0), z(x.MyLength());
+    low_rank_add(w, 1, rhs.data());
+    ok = direct_->solve(rhs.data(), z.data(), why);
+    ok = agree(comm_.Comm(), ok, why);
+    for (int i = 0; i < x.MyLength(); ++i) x[i] -= z[i];
+  }
   t_solve += now() - t0;
   return ok;
 }
@@ -312,6 +499,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   Epetra_Vector x0(map);
   for (int i = 0; i < map.NumMyElements(); ++i) x0[i] = state[map.GID(i)];
 
+  prepare_shape(d);
   auto iface = Teuchos::rcp(new StepInterface(*this, d));
   auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *iface));
   auto params = Teuchos::rcp(new Teuchos::ParameterList);
@@ -373,10 +561,11 @@ sp_energy_parts Solver::energy(const sp_model_params &m, const double *state) co
   return assembly_->energy(m, state);
 }
 
-void Solver::residual(const sp_step_data &d, const double *state, double *out) const {
+void Solver::residual(const sp_step_data &d, const double *state, double *out) {
   require_problem();
   Epetra_Vector F(assembly_->map());
-  assembly_->residual(d, state, F);
+  prepare_shape(d);
+  assembly_->residual(data_at(d, state), state, F);
   std::vector<double> full;
   gather(F, full);
   std::copy(full.begin(), full.end(), out);

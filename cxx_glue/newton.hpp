@@ -27,7 +27,8 @@ class Solver {
   // Returns 0 when converged, 1 when Newton failed (state restored).
   int step(const sp_step_data &data, double *state, sp_step_report &report);
   sp_energy_parts energy(const sp_model_params &m, const double *state) const;
-  void residual(const sp_step_data &data, const double *state, double *residual) const;
+  // (not const: an implicit shape term needs its weights for data)
+  void residual(const sp_step_data &data, const double *state, double *residual);
   double check_jacobian(const sp_step_data &data, const double *state, int kind) const;
   double compare_jacobians(const sp_step_data &data, const double *state, int kind_a,
                            int kind_b) const;
@@ -40,6 +41,8 @@ class Solver {
   void fill_residual(const sp_step_data &data, const Epetra_Vector &x, Epetra_Vector &F);
   void fill_jacobian(const sp_step_data &data, const Epetra_Vector &x);
   bool solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why);
+  // out = J in, J with the implicit shape term's low-rank part.
+  bool apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out);
 
   std::string last_error;
   Teuchos::RCP<Epetra_FECrsMatrix> jacobian_matrix;
@@ -47,6 +50,17 @@ class Solver {
 
  private:
   void require_problem() const;
+  // The implicit shape term (softpack_solver.h, sp_shape_coef): its weights
+  // for a step, the step data with the coefficients at a state, and the
+  // Woodbury factor of its low-rank Jacobian part.
+  void prepare_shape(const sp_step_data &data);
+  const sp_step_data &data_at(const sp_step_data &data, const double *state);
+  bool factor_low_rank(std::string &why);
+  // t[2a + j] = sum over this rank's rows of field f of active cell a of
+  // u_j x (reduced over the ranks).
+  void low_rank_dots(const double *x, int f, std::vector<double> &t) const;
+  // x[row] += sum_i u_i w[2a + i] over the rows of field f of active cell a.
+  void low_rank_add(const std::vector<double> &w, int f, double *x) const;
   // The full (replicated) state from a distributed vector.
   void gather(const Epetra_Vector &x, std::vector<double> &full) const;
 
@@ -61,6 +75,15 @@ class Solver {
   bool jacobian_fresh_ = false;  // the matrix changed since the last factor
   bool pattern_changed_ = true;  // the layout changed since the last factor
   std::vector<double> full_;     // scratch: the replicated state
+  // Implicit shape term of the current step (empty when explicit).
+  std::vector<double> shape_u_;            // 2 per pair (Assembly::shape_weights)
+  std::vector<sp_shape_coef> shape_coef_;  // the coefficients at the last state
+  sp_step_data shape_data_{};              // the step data pointing at them
+  std::vector<int> active_of_cell_;        // cell -> active index or -1
+  std::vector<double> active_gain_;        // 4 per active cell: C = -gain[i][j]
+  std::vector<int> row_active_;            // this rank's rows: active index or -1
+  std::vector<double> woodbury_lu_;        // K = I + C V^T A^-1 U, LU in place
+  std::vector<int> woodbury_piv_;
 };
 
 }  // namespace sp

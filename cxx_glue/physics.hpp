@@ -44,15 +44,18 @@ template <class S> S buffer_d1(const sp_model_params &m, const S &c) {
 }
 inline double buffer_d2(const sp_model_params &m) { return 2.0 * m.lambda_b; }
 
-// The explicit shape term's value in mu_k at X: -sum_i coef_i v_i.Ibar(X) v_i
-// with Ibar(X) = [[Xb2^2, -Xb1 Xb2], [-Xb1 Xb2, Xb1^2]] (MODEL.md).
+// Ihat = v . Ibar(Xb) v with Ibar(Xb) = [[Xb2^2, -Xb1 Xb2], [-Xb1 Xb2, Xb1^2]]
+// (MODEL.md): the derivative of the principal moment of eigenvector v in c.
+inline double shape_ihat(const double v[2], double xb, double yb) {
+  return v[0] * v[0] * yb * yb - 2.0 * v[0] * v[1] * xb * yb + v[1] * v[1] * xb * xb;
+}
+
+// The shape term's value in mu_k at X: -sum_i coef_i Ihat_i(X), with the
+// coefficients of the step (explicit, or updated by the Newton iterate's
+// moments when implicit: newton.cpp).
 inline double shape_mu(const sp_shape_coef &s, double x, double y) {
-  double xb = x - s.xc, yb = y - s.yc, value = 0.0;
-  for (int i = 0; i < 2; ++i) {
-    double v1 = s.v[i][0], v2 = s.v[i][1];
-    double ihat = v1 * v1 * yb * yb - 2.0 * v1 * v2 * xb * yb + v2 * v2 * xb * xb;
-    value -= s.coef[i] * ihat;
-  }
+  double value = 0.0;
+  for (int i = 0; i < 2; ++i) value -= s.coef[i] * shape_ihat(s.v[i], x - s.xc, y - s.yc);
   return value;
 }
 

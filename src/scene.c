@@ -134,6 +134,8 @@ static const cyaml_strval_t sp_cut_words[] = {
     {"sharp", SP_CUT_SHARP}, {"smooth", SP_CUT_SMOOTH}};
 static const cyaml_strval_t sp_line_words[] = {
     {"centre", SP_LINE_CENTRE}, {"equal_mass", SP_LINE_EQUAL_MASS}};
+static const cyaml_strval_t sp_shape_scheme_words[] = {
+    {"explicit", SP_SHAPE_EXPLICIT}, {"implicit", SP_SHAPE_IMPLICIT}};
 static const cyaml_strval_t sp_shrink_words[] = {
     {"divisions", SP_SHRINK_DIVISIONS}, {"always", SP_SHRINK_ALWAYS}};
 static const cyaml_strval_t sp_support_words[] = {
@@ -364,6 +366,11 @@ static const sp_key sp_keys[] = {
               UNBOUNDED, "E/L^6",
               "shape penalty modulus on the smaller principal moment I^2 "
               "(0: none; the paper: 5e4 to 2e5)"),
+    KEY_ENUM(SP_SEC_SHAPE, "scheme", shape.scheme, SP_SHAPE_EXPLICIT, sp_shape_scheme_words,
+             "-",
+             "explicit: coefficients from c^n (the paper); implicit: the "
+             "moments of the new state, linearised about c^n (stable for "
+             "stiff moduli; 2 extra solves per cell per Newton iteration)"),
     /* cells: one mapping per initial cell */
     CELL_FLOAT_REQUIRED("x", x, UNBOUNDED, UNBOUNDED, "L",
                         "centre x; the cell's disk must lie inside Omega"),

@@ -133,10 +133,14 @@ typedef struct {
                                 only the supports of dividing cells */
 } sp_scene_layout;
 
+/** How the shape term enters a step (src/shape.h). */
+typedef enum { SP_SHAPE_EXPLICIT = 0, SP_SHAPE_IMPLICIT = 1 } sp_shape_scheme;
+
 /** shape: the shape penalty on principal moments (MODEL.md, paper sec. 3). */
 typedef struct {
   double delta1; /**< modulus on the larger principal moment I^1 */
   double delta2; /**< modulus on the smaller principal moment I^2 */
+  sp_shape_scheme scheme; /**< explicit (the paper) or linearised implicit */
 } sp_scene_shape;
 
 typedef struct sp_scene {

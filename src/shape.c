@@ -13,7 +13,8 @@ int sp_shape_coefficients(int n_cells, const sp_cell_obs *obs, const sp_cell_bir
   for (int k = 0; k < n_cells; ++k) {
     const sp_cell_obs *o = &obs[k];
     sp_shape_coef *s = &out[k];
-    *s = (sp_shape_coef){.xc = 0, .yc = 0, .v = {{1, 0}, {0, 1}}, .coef = {0, 0}};
+    *s = (sp_shape_coef){.xc = 0, .yc = 0, .v = {{1, 0}, {0, 1}}, .coef = {0, 0},
+                         .gain = {{0, 0}, {0, 0}}};
     const double I[2] = {o->I1, o->I2};
     const double trace = I[0] + I[1];
     const int finite = isfinite(o->xc) && isfinite(o->yc) && isfinite(trace) &&
@@ -36,6 +37,11 @@ int sp_shape_coefficients(int n_cells, const sp_cell_obs *obs, const sp_cell_bir
     s->v[1][1] = o->v2[1];
     s->coef[0] = mean + w * half_diff;
     s->coef[1] = mean - w * half_diff;
+    /* coef = W c with W = [[1+w, 1-w], [1-w, 1+w]] / 2 and dc_j/dI_j =
+     * -2 delta^j: gain = -dcoef/dI = W diag(2 delta) (w frozen) */
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        s->gain[i][j] = 0.5 * (i == j ? 1.0 + w : 1.0 - w) * 2.0 * delta[j];
   }
   return SP_OK;
 }

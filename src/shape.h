@@ -59,7 +59,8 @@ extern "C" {
  * @param[in] birth per cell, the reference moments Iref[0] = I^1,ref,
  *            Iref[1] = I^2,ref
  * @param[in] delta1, delta2 the moduli on I^1 (the larger moment) and I^2
- * @param[out] out n_cells entries for sp_step_data.shape
+ * @param[out] out n_cells entries for sp_step_data.shape; their gain is
+ *             -d coef / d I with w frozen (used when the step is implicit)
  * @return SP_OK; SP_ERR_INPUT when a delta is negative or not finite
  */
 int sp_shape_coefficients(int n_cells, const sp_cell_obs *obs, const sp_cell_birth *birth,

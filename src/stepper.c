@@ -366,7 +366,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                           run->scene->source.rate, run->source);
       if (rc != SP_OK) break;
     }
-    if (shape_on) { /* explicit: from the observables of c^n (run->obs) */
+    if (shape_on) { /* from the observables of c^n (run->obs); implicit
+                     * steps follow the new moments through the gains */
       sp_shape_coef *grown_coef = realloc(shape_coef, sizeof *shape_coef * (size_t)n_cells);
       if (!grown_coef) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
       shape_coef = grown_coef;
@@ -380,7 +381,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     }
     sp_step_data data = {.dt = dt_try, .model = run->model, .state_old = run->state_old,
                          .source = run->scene->source.rate > 0 ? run->source : NULL,
-                         .shape = shape_on ? shape_coef : NULL};
+                         .shape = shape_on ? shape_coef : NULL,
+                         .shape_implicit = run->scene->shape.scheme == SP_SHAPE_IMPLICIT};
     sp_step_report report;
     int solved = sp_solver_step(run->solver, &data, run->state, &report);
     sum->t_assembly += report.t_assembly;

@@ -48,6 +48,24 @@ static inline void set_disk(const sp_mesh *mesh, const sp_layout *layout, double
   }
 }
 
+/** c_k = 1 / (1 + exp((rho - 1) / eps)), rho = sqrt((u/a)^2 + (v/b)^2),
+ *  (u, v) the coordinates along the ellipse's axes (the a axis at angle
+ *  phi), centred at (x, y), no background; mu_k = 0. */
+static inline void set_ellipse(const sp_mesh *mesh, const sp_layout *layout, double *state, int k,
+                               double x, double y, double a, double b, double phi,
+                               double eps) {
+  const double cs = cos(phi), sn = sin(phi);
+  for (int i = 0; i < mesh->n_nodes; ++i) {
+    const int p = sp_layout_pair(layout, k, i);
+    if (p < 0) continue;
+    const double dx = mesh->xy[2 * i] - x, dy = mesh->xy[2 * i + 1] - y;
+    const double u = cs * dx + sn * dy, v = -sn * dx + cs * dy;
+    const double rho = sqrt((u / a) * (u / a) + (v / b) * (v / b));
+    state[2 * p] = 1.0 / (1.0 + exp((rho - 1.0) / eps));
+    state[2 * p + 1] = 0.0;
+  }
+}
+
 static inline double energy_total(sp_solver s, const sp_model_params *m, const double *state) {
   sp_energy_parts e;
   if (sp_solver_energy(s, m, state, &e) != 0) {
