@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The paper's run 3 (docs/paper-runs.md, "Run 3"): one cell, shape penalty
 # delta1 = 0 and delta2 = 5e4, 1e5, 2e5 (inputs/paper/shape_delta_*.yaml);
-# with --hard also delta2 = 5e5 and 1e6 (the 2e5 scene with delta2 set).
+# with --hard also delta2 = 5e5 and 1e6 (the 2e5 scene with delta2 set);
+# with --implicit the shape term is implicit (shape.scheme: implicit).
 # Prints the equilibrium aspect ratio sqrt(I1/I2) of each run against delta2.
 #
-#   bench/paper_run3.sh [--hard] [--delta0]     (from the repository root)
+#   bench/paper_run3.sh [--hard] [--delta0] [--implicit]  (from the repository root)
 #
 # Environment: SOFTPACK (default build/softpack), OUT (default out/paper_run3).
 # One cell on the 5120-element ellipse: about a minute per run with serial
@@ -13,13 +14,15 @@ set -euo pipefail
 SOFTPACK=${SOFTPACK:-build/softpack}
 OUT=${OUT:-out/paper_run3}
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
+scheme=explicit
 runs=("5e4 inputs/paper/shape_delta_5e4.yaml" "1e5 inputs/paper/shape_delta_1e5.yaml"
       "2e5 inputs/paper/shape_delta_2e5.yaml")
 for arg in "$@"; do
   case $arg in
     --hard) runs+=("5e5 inputs/paper/shape_delta_2e5.yaml" "1e6 inputs/paper/shape_delta_2e5.yaml") ;;
     --delta0) runs=("0 inputs/paper/shape_delta_2e5.yaml" "${runs[@]}") ;;
-    *) echo "usage: $0 [--hard] [--delta0]" >&2; exit 2 ;;
+    --implicit) scheme=implicit ;;
+    *) echo "usage: $0 [--hard] [--delta0] [--implicit]" >&2; exit 2 ;;
   esac
 done
 mkdir -p "$OUT"
@@ -27,7 +30,8 @@ rows=()
 for run in "${runs[@]}"; do
   set -- $run
   delta=$1 scene=$2 dir="$OUT/delta_$1"
-  "$SOFTPACK" run "$scene" --out "$dir" --set shape.delta2="$delta" > "$dir.log" 2>&1 || {
+  "$SOFTPACK" run "$scene" --out "$dir" --set shape.delta2="$delta" \
+    --set shape.scheme=$scheme > "$dir.log" 2>&1 || {
     echo "delta2 = $delta: softpack failed, see $dir.log" >&2; exit 1; }
   # summary line: "N steps to t = ... (R failed attempts retried, ...)"
   steps=$(sed -n 's/^softpack: \([0-9]*\) steps.*/\1/p' "$dir.log")
@@ -38,8 +42,10 @@ for run in "${runs[@]}"; do
           a = sqrt($7 / $8); if (lo == "" || a < lo) lo = a; if (hi == "" || a > hi) hi = a
           if ($1 == last) { end = a; i1 = $7; i2 = $8 } }
         END { printf "%.4f | %.1e | %.3e | %.3e", end, hi - lo, i1, i2 }' "$dir/cells.csv")
-  rows+=("| $delta | $row | $steps | $retries |")
+  its=$(sed -n 's/.*), \([0-9]*\) Newton iterations.*/\1/p' "$dir.log")
+  rows+=("| $delta | $row | $steps | $retries | $its |")
 done
-echo "| delta2 | sqrt(I1/I2) at t_end | change over the last 100 steps | I1 | I2 | steps | retries |"
-echo "|---|---|---|---|---|---|---|"
+echo "shape.scheme: $scheme"
+echo "| delta2 | sqrt(I1/I2) at t_end | change over the last 100 steps | I1 | I2 | steps | retries | Newton its |"
+echo "|---|---|---|---|---|---|---|---|"
 printf '%s\n' "${rows[@]}"

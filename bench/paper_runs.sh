@@ -6,7 +6,8 @@
 #   bench/paper_runs.sh [--reuse] [run ...]
 #   runs: constant_volume_16 growth_12 embryo_8 growth_shape_12 (issue 4's run 4;
 #   with run 2 it prints the comparison of the two), and on request
-#   growth_shape_strong_12 (run 4 with the penalty dominating; added to the comparison)
+#   growth_shape_strong_12 and growth_shape_implicit_12 (run 4 with stronger
+#   penalties, the latter with the implicit term; added to the comparison)
 # --reuse: do not rerun a run whose out/paper/<run>/ and out/paper/<run>.log
 # exist (tables and pictures from that earlier run).
 set -euo pipefail
@@ -67,7 +68,7 @@ done
 if [ -f out/paper/growth_12/cells.csv ] && [ -f out/paper/growth_shape_12/cells.csv ]; then
   echo "== run 4 (shape penalty) against run 2"
   echo "   | run | cells | final energy (shape part) | largest energy | mean spike height | mean spike width | mean sqrt(I1/I2) | largest sqrt(I1/I2) |"
-  for run in growth_12 growth_shape_12 growth_shape_strong_12; do
+  for run in growth_12 growth_shape_12 growth_shape_strong_12 growth_shape_implicit_12; do
     out=out/paper/$run
     [ -f "$out/cells.csv" ] || continue
     e=$(awk -F, 'NR > 1 { last = $6; shape = $11; if ($6 > peak) peak = $6 } END { printf "%.4g (%.3g) | %.4g", last, shape, peak }' "$out/energy.csv")
