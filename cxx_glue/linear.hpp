@@ -40,6 +40,16 @@ class DirectSolver {
   // Solve A x = b with the last factorisation; b and x are this rank's
   // n_rows entries.
   virtual bool solve(const double *b, double *x, std::string &why) = 0;
+  // Solve A X = B for nrhs columns (column-major, each of this rank's
+  // n_rows entries). The default solves column by column.
+  virtual bool solve_many(const double *B, double *X, int nrhs, int n_rows, std::string &why) {
+    for (int j = 0; j < nrhs; ++j)
+      if (!solve(B + (size_t)j * n_rows, X + (size_t)j * n_rows, why)) return false;
+    return true;
+  }
+  // How many columns the solves after the next factor() will take (a
+  // backend whose solve set-up depends on it prepares for that count).
+  virtual void set_rhs_count(int) {}
   // Number of symbolic analyses done (for tests of the reuse).
   virtual int symbolic_count() const = 0;
 };

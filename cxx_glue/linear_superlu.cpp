@@ -81,13 +81,17 @@ class SuperLU final : public DirectSolver {
   }
 
   bool solve(const double *b, double *x, std::string &why) override {
-    if (!have_factors_) {
+    return solve_many(b, x, 1, n_, why);
+  }
+
+  bool solve_many(const double *b, double *x, int nrhs, int n_rows, std::string &why) override {
+    if (!have_factors_ || n_rows != n_) {
       why = "SuperLU: solve without a factorisation";
       return false;
     }
-    std::memcpy(x, b, sizeof(double) * n_);
+    std::memcpy(x, b, sizeof(double) * n_ * (size_t)nrhs);
     SuperMatrix B;
-    dCreate_Dense_Matrix(&B, n_, 1, x, n_, SLU_DN, SLU_D, SLU_GE);
+    dCreate_Dense_Matrix(&B, n_, nrhs, x, n_, SLU_DN, SLU_D, SLU_GE);
     int info = 0;
     dgstrs(TRANS, &L_, &U_, perm_c_.data(), perm_r_.data(), &B, &stat_, &info);
     Destroy_SuperMatrix_Store(&B);

@@ -15,6 +15,7 @@
 // superlu_ddefs.h clashes with SuperLU's slu_ddefs.h: keep it alone in this TU.
 #include <superlu_ddefs.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -63,6 +64,11 @@ class SuperLUDist final : public DirectSolver {
       ++symbolic_;
     } else {
       options_.Fact = SamePattern_SameRowPerm;
+      // The solve set-up is for solve_nrhs_ columns: for another count,
+      // drop it (with the refinement's), the next solve rebuilds it on the
+      // fresh matrix below.
+      if (options_.SolveInitialized == YES && next_nrhs_ != solve_nrhs_)
+        dSolveFinalize(&options_, &solve_);
       // The refinement's matrix-vector pattern was built on the previous
       // (renumbered) matrix: drop it, the next solve rebuilds it.
       if (options_.SolveInitialized == YES && options_.RefineInitialized == YES) {
@@ -102,18 +108,50 @@ class SuperLUDist final : public DirectSolver {
   }
 
   bool solve(const double *b, double *x, std::string &why) override {
-    if (!factored_once_) {
+    return solve_many(b, x, 1, m_loc_, why);
+  }
+
+  // The solve set-up (pdgstrs_init) is for one column count, and rebuilding
+  // it after a solve would redo the refinement's set-up on the already
+  // renumbered column indices: other counts are solved in blocks of the
+  // set-up's count, padded with zero columns. set_rhs_count() before a
+  // factorisation changes the count safely (factor() starts from fresh
+  // arrays).
+  bool solve_many(const double *b, double *x, int nrhs, int n_rows, std::string &why) override {
+    if (!factored_once_ || n_rows != m_loc_) {
       why = "SuperLU_DIST: solve without a factorisation";
       return false;
     }
-    std::memcpy(x, b, sizeof(double) * m_loc_);
+    const int ld = m_loc_ > 0 ? m_loc_ : 1;
+    if (options_.SolveInitialized == NO) solve_nrhs_ = nrhs;
+    if (nrhs == solve_nrhs_) {
+      std::memcpy(x, b, sizeof(double) * m_loc_ * (size_t)nrhs);
+      return pdgssvx_solve(x, ld, nrhs, why);
+    }
+    std::vector<double> block((size_t)ld * solve_nrhs_);
+    for (int j0 = 0; j0 < nrhs; j0 += solve_nrhs_) {
+      const int cols = std::min(solve_nrhs_, nrhs - j0);
+      std::fill(block.begin(), block.end(), 0.0);
+      std::memcpy(block.data(), b + (size_t)j0 * m_loc_, sizeof(double) * m_loc_ * (size_t)cols);
+      if (!pdgssvx_solve(block.data(), ld, solve_nrhs_, why)) return false;
+      std::memcpy(x + (size_t)j0 * m_loc_, block.data(), sizeof(double) * m_loc_ * (size_t)cols);
+    }
+    return true;
+  }
+
+  void set_rhs_count(int nrhs) override { next_nrhs_ = nrhs; }
+
+  int symbolic_count() const override { return symbolic_; }
+
+ private:
+  bool pdgssvx_solve(double *x, int ld, int nrhs, std::string &why) {
     options_.Fact = FACTORED;
     SuperLUStat_t stat;
     PStatInit(&stat);
     int info = 0;
-    double berr = 0;
-    pdgssvx(&options_, &A_, &scale_perm_, x, m_loc_ > 0 ? m_loc_ : 1, 1, &grid_, &lu_, &solve_,
-            &berr, &stat, &info);
+    std::vector<double> berr(nrhs, 0.0);
+    pdgssvx(&options_, &A_, &scale_perm_, x, ld, nrhs, &grid_, &lu_, &solve_, berr.data(), &stat,
+            &info);
     PStatFree(&stat);
     if (info != 0) {
       why = "SuperLU_DIST: the solve failed (info " + std::to_string(info) + ")";
@@ -122,9 +160,6 @@ class SuperLUDist final : public DirectSolver {
     return true;
   }
 
-  int symbolic_count() const override { return symbolic_; }
-
- private:
   void release() {
     if (options_.SolveInitialized == YES) dSolveFinalize(&options_, &solve_);
     if (have_structs_) {
@@ -148,6 +183,7 @@ class SuperLUDist final : public DirectSolver {
   SuperMatrix A_;
   bool have_structs_ = false, have_lu_ = false, have_matrix_ = false, factored_once_ = false;
   int n_ = 0, m_loc_ = 0, fst_row_ = 0, symbolic_ = 0;
+  int solve_nrhs_ = 1, next_nrhs_ = 1;  // columns of the solve set-up, and of the next
   std::vector<int_t> ptr_saved_, col_saved_, ptr_, col_;
   std::vector<double> val_;
 };

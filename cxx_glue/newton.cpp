@@ -260,6 +260,7 @@ void Solver::prepare_shape(const sp_step_data &d) {
   active_gain_.clear();
   row_active_.clear();
   woodbury_lu_.clear();
+  woodbury_z_.clear();
   if (!d.shape || !d.shape_implicit) return;
   const int n_cells = assembly_->n_cells();
   active_of_cell_.assign(n_cells, -1);
@@ -347,27 +348,31 @@ std::vector<double> times_gain(const std::vector<double> &gain, const std::vecto
 // The Jacobian is A + U C V^T: A the sparse (element) part, U's columns the
 // shape weights u_i of an active cell on its mu rows, V's the same on its c
 // rows, C = -gain per cell (R_mu holds +coef_i u_i, and coef_i falls by
-// gain[i][j] dI_j). Woodbury: x = y - A^-1 U w with y = A^-1 b and
-// (I + C V^T A^-1 U) w = C V^T y. K = I + C V^T A^-1 U costs 2 solves per
-// active cell per factorisation (counted in t_solve) and is LU-factored
-// here, identically on every rank.
-bool Solver::factor_low_rank(std::string &why) {
+// gain[i][j] dI_j). Woodbury: x = y - Z w with y = A^-1 b, Z = A^-1 U and
+// (I + C V^T Z) w = C V^T y. After each factorisation, b and the 2 columns
+// of U per active cell are solved as one block (y and Z: counted in
+// t_solve), and K = I + C V^T Z is LU-factored here, identically on every
+// rank; Z is kept for further solves with the same factorisation.
+bool Solver::factor_low_rank(const double *b, double *y, std::string &why) {
   const int m = (int)active_gain_.size() / 2;
   const int n = (int)row_active_.size();
-  std::vector<double> S((size_t)m * m), col(m, 0.0), b(n), z(n), t;
-  double t0 = now();
+  std::vector<double> B((size_t)n * (m + 1), 0.0), X((size_t)n * (m + 1)), col(m, 0.0), t;
+  std::copy(b, b + n, B.begin());
   for (int c = 0; c < m; ++c) {
-    std::fill(b.begin(), b.end(), 0.0);
-    std::fill(col.begin(), col.end(), 0.0);
     col[c] = 1.0;
-    low_rank_add(col, 1, b.data());
-    bool ok = direct_->solve(b.data(), z.data(), why);
-    if (!agree(comm_.Comm(), ok, why)) return false;
-    low_rank_dots(z.data(), 0, t);
+    low_rank_add(col, 1, B.data() + (size_t)(c + 1) * n);
+    col[c] = 0.0;
+  }
+  bool ok = direct_->solve_many(B.data(), X.data(), m + 1, n, why);
+  if (!agree(comm_.Comm(), ok, why)) return false;
+  std::copy(X.begin(), X.begin() + n, y);
+  woodbury_z_.assign(X.begin() + n, X.end());
+  // S = V^T Z, then K = I + C S, row r = 2a + i: sum_j C_a[i][j] S[2a + j][.]
+  std::vector<double> S((size_t)m * m);
+  for (int c = 0; c < m; ++c) {
+    low_rank_dots(woodbury_z_.data() + (size_t)c * n, 0, t);
     for (int r = 0; r < m; ++r) S[(size_t)r * m + c] = t[r];
   }
-  t_solve += now() - t0;
-  // K = I + C S, row r = 2a + i: sum_j gain_a[i][j] S[2a + j][.]
   woodbury_lu_.assign((size_t)m * m, 0.0);
   for (int r = 0; r < m; ++r) {
     const int a = r / 2, i = r % 2;
@@ -396,6 +401,23 @@ bool Solver::factor_low_rank(std::string &why) {
     }
   }
   return true;
+}
+
+void Solver::woodbury_correct(double *x) const {
+  std::vector<double> t;
+  low_rank_dots(x, 0, t);
+  std::vector<double> w = times_gain(active_gain_, t);  // C V^T y
+  const int m = (int)w.size(), n = (int)row_active_.size();
+  const double *K = woodbury_lu_.data();
+  for (int k = 0; k < m; ++k) std::swap(w[k], w[woodbury_piv_[k]]);
+  for (int r = 0; r < m; ++r)
+    for (int c = 0; c < r; ++c) w[r] -= K[(size_t)r * m + c] * w[c];
+  for (int r = m - 1; r >= 0; --r) {
+    for (int c = r + 1; c < m; ++c) w[r] -= K[(size_t)r * m + c] * w[c];
+    w[r] /= K[(size_t)r * m + r];
+  }
+  for (int c = 0; c < m; ++c)
+    for (int i = 0; i < n; ++i) x[i] -= woodbury_z_[(size_t)c * n + i] * w[c];
 }
 
 bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out) {
@@ -448,6 +470,7 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
     A.row_ptr = csr_ptr_.data();
     A.col = csr_col_.data();
     A.val = csr_val_.data();
+    direct_->set_rhs_count(low_rank ? (int)active_gain_.size() / 2 + 1 : 1);
     bool ok = direct_->factor(A, !pattern_changed_, why);
     ok = agree(comm_.Comm(), ok, why);
     t_factor += now() - t0;
@@ -457,35 +480,19 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
     }
     pattern_changed_ = false;
     jacobian_fresh_ = false;
-    if (low_rank && !factor_low_rank(why)) {
-      pattern_changed_ = true;
-      jacobian_fresh_ = true;  // K is stale: refactor before the next solve
-      return false;
+    if (low_rank) {
+      t0 = now();
+      ok = factor_low_rank(b.Values(), x.Values(), why);
+      if (ok) woodbury_correct(x.Values());
+      t_solve += now() - t0;
+      if (!ok) jacobian_fresh_ = true;  // K is stale: refactor before the next solve
+      return ok;
     }
   }
   double t0 = now();
   bool ok = direct_->solve(b.Values(), x.Values(), why);
   ok = agree(comm_.Comm(), ok, why);
-  if (ok && low_rank) {
-    // w = K^-1 C V^T y, then x -= A^-1 U w
-    std::vector<double> t;
-    low_rank_dots(x.Values(), 0, t);
-    std::vector<double> w = times_gain(active_gain_, t);
-    const int m = (int)w.size();
-    const double *K = woodbury_lu_.data();
-    for (int k = 0; k < m; ++k) std::swap(w[k], w[woodbury_piv_[k]]);
-    for (int r = 0; r < m; ++r)
-      for (int c = 0; c < r; ++c) w[r] -= K[(size_t)r * m + c] * w[c];
-    for (int r = m - 1; r >= 0; --r) {
-      for (int c = r + 1; c < m; ++c) w[r] -= K[(size_t)r * m + c] * w[c];
-      w[r] /= K[(size_t)r * m + r];
-    }
-    std::vector<double> rhs(x.MyLength(), 0.0), z(x.MyLength());
-    low_rank_add(w, 1, rhs.data());
-    ok = direct_->solve(rhs.data(), z.data(), why);
-    ok = agree(comm_.Comm(), ok, why);
-    for (int i = 0; i < x.MyLength(); ++i) x[i] -= z[i];
-  }
+  if (ok && low_rank) woodbury_correct(x.Values());
   t_solve += now() - t0;
   return ok;
 }

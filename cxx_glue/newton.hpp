@@ -55,7 +55,10 @@ class Solver {
   // Woodbury factor of its low-rank Jacobian part.
   void prepare_shape(const sp_step_data &data);
   const sp_step_data &data_at(const sp_step_data &data, const double *state);
-  bool factor_low_rank(std::string &why);
+  // After a factorisation: y = A^-1 b and Z = A^-1 U in one block solve,
+  // and the LU of K; woodbury_correct turns y into the solution.
+  bool factor_low_rank(const double *b, double *y, std::string &why);
+  void woodbury_correct(double *y) const;
   // t[2a + j] = sum over this rank's rows of field f of active cell a of
   // u_j x (reduced over the ranks).
   void low_rank_dots(const double *x, int f, std::vector<double> &t) const;
@@ -83,6 +86,7 @@ class Solver {
   std::vector<double> active_gain_;        // 4 per active cell: C = -gain[i][j]
   std::vector<int> row_active_;            // this rank's rows: active index or -1
   std::vector<double> woodbury_lu_;        // K = I + C V^T A^-1 U, LU in place
+  std::vector<double> woodbury_z_;         // Z = A^-1 U, this rank's rows, by column
   std::vector<int> woodbury_piv_;
 };
 

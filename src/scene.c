@@ -370,7 +370,8 @@ static const sp_key sp_keys[] = {
              "-",
              "explicit: coefficients from c^n (the paper); implicit: the "
              "moments of the new state, linearised about c^n (stable for "
-             "stiff moduli; 2 extra solves per cell per Newton iteration)"),
+             "stiff moduli; 2 extra right-hand sides per cell in each Newton "
+             "iteration's solve)"),
     /* cells: one mapping per initial cell */
     CELL_FLOAT_REQUIRED("x", x, UNBOUNDED, UNBOUNDED, "L",
                         "centre x; the cell's disk must lie inside Omega"),

@@ -21,8 +21,10 @@ static inline sp_model_params paper_model(void) {
   return m;
 }
 
-static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout, int jacobian) {
-  sp_solver_options opt = {.jacobian = jacobian, .linear = SP_SOLVER_SUPERLU,
+/** A solver with direct solver @p linear (SP_SOLVER_*) on the mesh and layout. */
+static inline sp_solver make_solver_with(const sp_mesh *mesh, const sp_layout *layout,
+                                         int jacobian, int linear) {
+  sp_solver_options opt = {.jacobian = jacobian, .linear = linear,
                            .newton_rtol = 1e-10, .newton_atol = 1e-11, .newton_max_its = 20};
   sp_solver s = NULL;
   if (sp_solver_create(MPI_COMM_WORLD, &opt, &s) != 0) {
@@ -34,6 +36,10 @@ static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout
     exit(1);
   }
   return s;
+}
+
+static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout, int jacobian) {
+  return make_solver_with(mesh, layout, jacobian, SP_SOLVER_SUPERLU);
 }
 
 /** c_k = tanh disk of radius R at (x, y) with width d; mu_k = 0. */

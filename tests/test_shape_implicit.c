@@ -8,7 +8,8 @@
  *    the small shift of the sampled ellipses' discrete centre and axes,
  *    which it keeps frozen at c^n);
  * 2. Newton with its low-rank Jacobian (Woodbury) converges quadratically
- *    at a modulus 50x the paper's stiffness limit;
+ *    at a modulus 50x the paper's stiffness limit, with SuperLU and with
+ *    SuperLU_DIST (block solves);
  * 3. at that modulus, without a source, the total energy (fields + shape)
  *    never rises over 20 steps at the paper's dt, and the cell settles
  *    between its start and its reference moment. */
@@ -120,7 +121,7 @@ typedef struct {
   sp_step_report first;
 } relax_result;
 
-static relax_result relax(double delta2, int implicit, int steps, double dt) {
+static relax_result relax(double delta2, int implicit, int steps, double dt, int linear) {
   relax_result out = {.ok = 1};
   sp_mesh *mesh;
   sp_layout *layout;
@@ -136,7 +137,7 @@ static relax_result relax(double delta2, int implicit, int steps, double dt) {
   const sp_cell_birth birth = {.birth_mass = obs.mass_core, .Iref = {obs.I1, 0.7 * obs.I2}};
   out.i2_start = obs.I2;
   out.i2_ref = birth.Iref[1];
-  sp_solver solver = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
+  sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, linear);
   double energy = energy_total(solver, &model, state) +
                   sp_shape_energy(1, &obs, &birth, 0.0, delta2);
   out.energy_start = energy;
@@ -172,13 +173,14 @@ static relax_result relax(double delta2, int implicit, int steps, double dt) {
   return out;
 }
 
-/* 2. Newton's order with the low-rank Jacobian. */
-static void test_newton(void) {
+/* 2. Newton's order with the low-rank Jacobian, with serial SuperLU and
+ * with SuperLU_DIST (whose block solves of b and U differ). */
+static void test_newton(int linear, const char *name) {
   const double delta2 = 1e7;
-  relax_result r = relax(delta2, 1, 1, 2e-4);
+  relax_result r = relax(delta2, 1, 1, 2e-4, linear);
   const sp_step_report *rep = &r.first;
-  printf("newton: one implicit step, delta2 = %g, dt = 2e-4: %d iterations, |F|:", delta2,
-         rep->newton_its);
+  printf("newton (%s): one implicit step, delta2 = %g, dt = 2e-4: %d iterations, |F|:", name,
+         delta2, rep->newton_its);
   for (int i = 0; i < rep->n_residuals; ++i) printf(" %.2e", rep->residual_norms[i]);
   printf("\n");
   CHECK(r.ok, "the step failed: %s", rep->reason);
@@ -202,8 +204,8 @@ static void test_newton(void) {
 static void test_stiff(void) {
   const double delta2 = 1e7, dt = 2e-4;
   const int steps = 20;
-  relax_result imp = relax(delta2, 1, steps, dt);
-  relax_result exp_ = relax(delta2, 0, steps, dt);
+  relax_result imp = relax(delta2, 1, steps, dt, SP_SOLVER_SUPERLU);
+  relax_result exp_ = relax(delta2, 0, steps, dt, SP_SOLVER_SUPERLU);
   printf("stiff: delta2 = %g, %d steps of %g, no source, I2 start %.4e, I2,ref %.4e:\n", delta2,
          steps, dt, imp.i2_start, imp.i2_ref);
   printf("  implicit: %d steps, %d Newton its, energy %.6g -> %.6g, largest rise %.1e, "
@@ -223,7 +225,8 @@ static void test_stiff(void) {
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   test_residual();
-  test_newton();
+  test_newton(SP_SOLVER_SUPERLU, "superlu");
+  test_newton(SP_SOLVER_SUPERLU_DIST, "superlu_dist");
   test_stiff();
   MPI_Finalize();
   TEST_DONE();
