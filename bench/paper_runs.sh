@@ -65,9 +65,11 @@ done
 # (peak - e0) / e0 with e0 the energy of step S-1 and the peak the largest
 # energy before the next division; width: time from step S-1 until the
 # energy is back to e0 + half the height (">" if the next division came first).
+# Packing: the cells' aspect ratios sqrt(I1/I2), and the area inside their
+# membranes (cells.csv's area, c_k >= 1/2) over Omega's, pi semi_x semi_y.
 if [ -f out/paper/growth_12/cells.csv ] && [ -f out/paper/growth_shape_12/cells.csv ]; then
   echo "== run 4 (shape penalty) against run 2"
-  echo "   | run | cells | final energy (shape part) | largest energy | mean spike height | mean spike width | mean sqrt(I1/I2) | largest sqrt(I1/I2) |"
+  echo "   | run | cells | final energy (shape part) | largest energy | mean spike height | mean spike width | mean sqrt(I1/I2) | largest sqrt(I1/I2) | interiors / Omega |"
   for run in growth_12 growth_shape_12 growth_shape_strong_12 growth_shape_implicit_12; do
     out=out/paper/$run
     [ -f "$out/cells.csv" ] || continue
@@ -88,6 +90,11 @@ if [ -f out/paper/growth_12/cells.csv ] && [ -f out/paper/growth_shape_12/cells.
       END { s = 0; m = 0; for (k = 1; k <= n[last]; ++k) { s += r[last, k]; if (r[last, k] > m) m = r[last, k] }
             printf "%d | %.3f | %.3f", n[last], s / n[last], m }' "$out/cells.csv")
     cells=${a%% *}
-    echo "   | $run | $cells | $e | $spikes | ${a#* | } |"
+    omega=$(sed -n 's/.*semi_x: *\([0-9.e+-]*\), *semi_y: *\([0-9.e+-]*\).*/\1 \2/p' \
+      "inputs/paper/$run.yaml" | awk '{ printf "%.10g", 3.14159265358979 * $1 * $2 }')
+    covered=$(awk -F, -v omega="$omega" 'NR == 1 { has = $11 == "area"; next }
+      { last = $1; area[$1] += $11 } END { if (has) printf "%.3f", area[last] / omega; else printf "-" }' \
+      "$out/cells.csv")
+    echo "   | $run | $cells | $e | $spikes | ${a#* | } | $covered |"
   done
 fi

@@ -46,9 +46,9 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
                      const double *state, double weight_threshold,
                      sp_cell_obs *obs) {
   const int nc = layout->n_cells;
-  /* Per cell: mass, weighted mass, first and second moments. */
+  /* Per cell: mass, weighted mass, first and second moments, area. */
   double *sums;
-  SP_ALLOC(sums, 7 * (size_t)nc);
+  SP_ALLOC(sums, 8 * (size_t)nc);
   for (int e = 0; e < mesh->n_elems; ++e) {
     double xy[4][2];
     sp_mesh_elem_xy(mesh, e, xy);
@@ -65,8 +65,9 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
         if (!whole) continue;
         double c = 0;
         for (int b = 0; b < 4; ++b) c += N[b] * state[2 * pairs[b]];
-        double *s = sums + 7 * k;
+        double *s = sums + 8 * k;
         s[0] += w * c;
+        if (c >= 0.5) s[7] += w;
         const double cw = c >= weight_threshold ? c : 0.0;
         s[1] += w * cw;
         s[2] += w * cw * x[0];
@@ -78,9 +79,10 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
     }
   }
   for (int k = 0; k < nc; ++k) {
-    const double *s = sums + 7 * k;
+    const double *s = sums + 8 * k;
     sp_cell_obs *o = obs + k;
     o->mass = s[0];
+    o->area = s[7];
     o->mass_core = s[1];
     const double m = s[1] > 0 ? s[1] : 1.0;
     o->xc = s[2] / m;

@@ -26,6 +26,8 @@ typedef struct {
   double I1, I2;    /**< principal moments, I1 >= I2 */
   double v1[2], v2[2]; /**< unit eigenvectors of I1 and I2 */
   double angle;     /**< angle of v1 from the x axis, in (-pi/2, pi/2] */
+  double area;      /**< area where c_k >= 1/2 (inside the membrane; at the
+                         quadrature points, whatever the weight threshold) */
 } sp_cell_obs;
 
 /**

@@ -222,7 +222,7 @@ int sp_output_open(const char *dir, sp_output *out) {
                      "supports_s,support_changed,unknowns",
                      &o->energy);
   if (rc == SP_OK)
-    rc = sp_log_open(o->cells_path, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass",
+    rc = sp_log_open(o->cells_path, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass,area",
                      &o->cells);
   if (rc == SP_OK)
     rc = sp_log_open(o->divisions_path,
@@ -258,9 +258,9 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
                     const sp_cell_obs *obs) {
   int n = 0;
   for (int k = 0; k < n_cells && n >= 0; ++k)
-    n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+    n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
                 step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].I1,
-                obs[k].I2, obs[k].angle, obs[k].mass_core);
+                obs[k].I2, obs[k].angle, obs[k].mass_core, obs[k].area);
   return sp_log_done(out->cells, out->cells_path, n);
 }
 

@@ -227,7 +227,7 @@ int main(void) {
   /* ---- cells.csv ---- */
   {
     char *csv = slurp(DIR "/cells.csv", NULL);
-    CHECK(csv && strncmp(csv, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass\n", 45) == 0,
+    CHECK(csv && strncmp(csv, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass,area\n", 50) == 0,
           "cells.csv header");
     if (csv) {
       CHECK(count_substr(csv, "\n") == 5, "cells.csv: %d lines, expected 5",

@@ -1,7 +1,7 @@
 /* The shape penalty (src/shape.c, MODEL.md "Shape penalty"):
  * - inertia tensors of a disk, an ellipse and a rotated ellipse with a thin
  *   tanh profile against the profile's exact integrals, on three meshes
- *   (second order in h);
+ *   (second order in h), and the area inside c = 1/2 against pi a b;
  * - Ihat^i(X) = v_i . Ibar(X) v_i: int N_j Ihat^i equals the central
  *   difference dI^i/dc_j, and the glue's mu term is minus the derivative of
  *   the reported shape energy (its sign);
@@ -72,7 +72,12 @@ static void test_tensors(void) {
           a > b ? asin(fmin(1.0, fabs(obs.v1[0] * cs + obs.v1[1] * sn))) : 0.0;
       printf("  %-32s | %4d | %22.3e | %.4f (%.4f) | %.2e\n", shapes[s].name, meshes[m],
              error[m], obs.I1 / obs.I2, Su / Sv, angle_error);
+      /* the c = 1/2 level set is rho = 1: the area inside is pi a b */
+      const double area_error = fabs(obs.area - PI * a * b) / (PI * a * b);
+      printf("  %-32s | %4d | area (c >= 1/2) %.6f, pi a b %.6f: relative error %.1e\n",
+             shapes[s].name, meshes[m], obs.area, PI * a * b, area_error);
       if (m == 2) {
+        CHECK(area_error < 2e-3, "%s: area off by %.3g relative", shapes[s].name, area_error);
         CHECK(error[m] < 2e-4, "%s: tensor error %.3g on the finest mesh", shapes[s].name,
               error[m]);
         if (a > b) CHECK(angle_error < 1e-4, "%s: v1 off by %.3g rad", shapes[s].name,
