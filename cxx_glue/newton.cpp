@@ -257,7 +257,7 @@ void Solver::prepare_shape(const sp_step_data &d) {
   shape_u_.clear();
   shape_coef_.clear();
   active_of_cell_.clear();
-  active_gain_.clear();
+  low_rank_c_.clear();
   row_active_.clear();
   woodbury_lu_.clear();
   woodbury_z_.clear();
@@ -277,7 +277,7 @@ void Solver::prepare_shape(const sp_step_data &d) {
     if (!any) continue;
     active_of_cell_[k] = n_active++;
     for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2; ++j) active_gain_.push_back(-sc.gain[i][j]);
+      for (int j = 0; j < 2; ++j) low_rank_c_.push_back(-sc.gain[i][j]);
   }
   shape_coef_.assign(d.shape, d.shape + n_cells);
   shape_data_ = d;
@@ -312,7 +312,7 @@ const sp_step_data &Solver::data_at(const sp_step_data &d, const double *state) 
 
 void Solver::low_rank_dots(const double *x, int f, std::vector<double> &t) const {
   const Epetra_Map &map = assembly_->map();
-  std::vector<double> mine(active_gain_.size() / 2, 0.0);
+  std::vector<double> mine(low_rank_c_.size() / 2, 0.0);
   for (int r = 0; r < (int)row_active_.size(); ++r) {
     const int a = row_active_[r], g = map.GID(r);
     if (a < 0 || g % 2 != f) continue;
@@ -334,12 +334,12 @@ void Solver::low_rank_add(const std::vector<double> &w, int f, double *x) const 
 
 namespace {
 
-// C t per active cell: (C t)[2a + i] = sum_j gain_a[i][j] t[2a + j].
-std::vector<double> times_gain(const std::vector<double> &gain, const std::vector<double> &t) {
+// C t per active cell: (C t)[2a + i] = sum_j C_a[i][j] t[2a + j], C_a = -gain.
+std::vector<double> times_c(const std::vector<double> &c, const std::vector<double> &t) {
   std::vector<double> out(t.size());
   for (size_t a = 0; 2 * a < t.size(); ++a)
     for (int i = 0; i < 2; ++i)
-      out[2 * a + i] = gain[4 * a + 2 * i] * t[2 * a] + gain[4 * a + 2 * i + 1] * t[2 * a + 1];
+      out[2 * a + i] = c[4 * a + 2 * i] * t[2 * a] + c[4 * a + 2 * i + 1] * t[2 * a + 1];
   return out;
 }
 
@@ -354,7 +354,7 @@ std::vector<double> times_gain(const std::vector<double> &gain, const std::vecto
 // t_solve), and K = I + C V^T Z is LU-factored here, identically on every
 // rank; Z is kept for further solves with the same factorisation.
 bool Solver::factor_low_rank(const double *b, double *y, std::string &why) {
-  const int m = (int)active_gain_.size() / 2;
+  const int m = (int)low_rank_c_.size() / 2;
   const int n = (int)row_active_.size();
   std::vector<double> B((size_t)n * (m + 1), 0.0), X((size_t)n * (m + 1)), col(m, 0.0), t;
   std::copy(b, b + n, B.begin());
@@ -378,8 +378,8 @@ bool Solver::factor_low_rank(const double *b, double *y, std::string &why) {
     const int a = r / 2, i = r % 2;
     for (int c = 0; c < m; ++c)
       woodbury_lu_[(size_t)r * m + c] = (r == c ? 1.0 : 0.0) +
-                                        active_gain_[4 * a + 2 * i] * S[(size_t)(2 * a) * m + c] +
-                                        active_gain_[4 * a + 2 * i + 1] * S[(size_t)(2 * a + 1) * m + c];
+                                        low_rank_c_[4 * a + 2 * i] * S[(size_t)(2 * a) * m + c] +
+                                        low_rank_c_[4 * a + 2 * i + 1] * S[(size_t)(2 * a + 1) * m + c];
   }
   // LU with partial pivoting (small and dense: 2 per active cell).
   woodbury_piv_.assign(m, 0);
@@ -406,7 +406,7 @@ bool Solver::factor_low_rank(const double *b, double *y, std::string &why) {
 void Solver::woodbury_correct(double *x) const {
   std::vector<double> t;
   low_rank_dots(x, 0, t);
-  std::vector<double> w = times_gain(active_gain_, t);  // C V^T y
+  std::vector<double> w = times_c(low_rank_c_, t);  // C V^T y
   const int m = (int)w.size(), n = (int)row_active_.size();
   const double *K = woodbury_lu_.data();
   for (int k = 0; k < m; ++k) std::swap(w[k], w[woodbury_piv_[k]]);
@@ -425,7 +425,7 @@ bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out) {
   if (shape_u_.empty()) return true;
   std::vector<double> t;
   low_rank_dots(in.Values(), 0, t);
-  low_rank_add(times_gain(active_gain_, t), 1, out.Values());
+  low_rank_add(times_c(low_rank_c_, t), 1, out.Values());
   return true;
 }
 
@@ -470,7 +470,7 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
     A.row_ptr = csr_ptr_.data();
     A.col = csr_col_.data();
     A.val = csr_val_.data();
-    direct_->set_rhs_count(low_rank ? (int)active_gain_.size() / 2 + 1 : 1);
+    direct_->set_rhs_count(low_rank ? (int)low_rank_c_.size() / 2 + 1 : 1);
     bool ok = direct_->factor(A, !pattern_changed_, why);
     ok = agree(comm_.Comm(), ok, why);
     t_factor += now() - t0;

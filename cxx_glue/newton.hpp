@@ -83,7 +83,7 @@ class Solver {
   std::vector<sp_shape_coef> shape_coef_;  // the coefficients at the last state
   sp_step_data shape_data_{};              // the step data pointing at them
   std::vector<int> active_of_cell_;        // cell -> active index or -1
-  std::vector<double> active_gain_;        // 4 per active cell: C = -gain[i][j]
+  std::vector<double> low_rank_c_;        // 4 per active cell: C = -gain[i][j]
   std::vector<int> row_active_;            // this rank's rows: active index or -1
   std::vector<double> woodbury_lu_;        // K = I + C V^T A^-1 U, LU in place
   std::vector<double> woodbury_z_;         // Z = A^-1 U, this rank's rows, by column

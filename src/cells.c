@@ -42,6 +42,32 @@ int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, d
   return SP_OK;
 }
 
+int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *w) {
+  SP_CHECK(layout->n_nodes == mesh->n_nodes, SP_ERR_INTERNAL,
+           "pair weights: %d nodes in the layout, %d in the mesh", layout->n_nodes,
+           mesh->n_nodes);
+  for (int p = 0; p < layout->n_pairs; ++p) w[p] = 0.0;
+  for (int e = 0; e < mesh->n_elems; ++e) {
+    const int *nodes = mesh->elem + 4 * e;
+    double xy[4][2];
+    int have_xy = 0;
+    for (int p0 = layout->node_start[nodes[0]]; p0 < layout->node_start[nodes[0] + 1]; ++p0) {
+      const int k = layout->pair_cell[p0];
+      int pairs[4] = {p0, -1, -1, -1}, whole = 1;
+      for (int b = 1; b < 4 && whole; ++b) whole = (pairs[b] = sp_layout_pair(layout, k, nodes[b])) >= 0;
+      if (!whole) continue;
+      if (!have_xy) sp_mesh_elem_xy(mesh, e, xy);
+      have_xy = 1;
+      for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+        double N[4], dNdx[4][2], x[2], wq;
+        sp_q1_point(xy, q, N, dNdx, x, &wq);
+        for (int b = 0; b < 4; ++b) w[pairs[b]] += wq * N[b];
+      }
+    }
+  }
+  return SP_OK;
+}
+
 int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
                      const double *state, double weight_threshold,
                      sp_cell_obs *obs) {

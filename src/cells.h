@@ -51,6 +51,14 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
  */
 int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, double *w);
 
+/**
+ * @brief The node weights of every cell at once, per pair: w[p] = the node
+ *        weight (sp_cells_node_weights) of pair p's node for pair p's cell.
+ *        One pass over the elements (not one per cell).
+ * @param[out] w layout->n_pairs values
+ */
+int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *w);
+
 /** @brief Principal moments and unit eigenvectors of a symmetric 2x2
  *         tensor, larger first (v1 is the larger moment's). */
 void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,

@@ -1,7 +1,8 @@
 /**
  * @file shape.h
  * @brief The shape penalty on principal moments of inertia (MODEL.md "Shape
- *        penalty", paper section 3), explicit in time as in the paper:
+ *        penalty", paper section 3), explicit in time as in the paper, or
+ *        linearised implicit (shape.scheme; softpack_solver.h, the gains):
  *
  *     Pi_MI = sum_k sum_i delta^i (I_k^i,ref - I_k^i)^2,
  *     mu_k += - sum_i 2 delta^i (I_k^i,ref - I_k^i) Ihat_k^i(X),
@@ -11,7 +12,8 @@
  * with I^1 >= I^2 the principal moments and v_1, v_2 their unit
  * eigenvectors, all from the observables at t^n (sp_cells_observe). The glue
  * adds -sum_i coef_i v_i . Ibar(X) v_i to mu_k for the sp_shape_coef of each
- * cell (cxx_glue/physics.hpp, shape_mu).
+ * cell (cxx_glue/physics.hpp, shape_mu); when the step is implicit it first
+ * moves coef by -gain dI, dI the new state's change of the moments.
  *
  * Round cells. For I^1 = I^2 the eigenvectors are arbitrary, and for
  * I^1 ~ I^2 they swing with every small change of c: the exact force

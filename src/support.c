@@ -219,72 +219,77 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   sp_cell_obs *before, *after;
   SP_ALLOC(before, nc);
   SP_ALLOC(after, nc);
-  for (int k = 0; k < nc; ++k) {
-    /* New nodes continue the far field: the old edge's mean c_e where the
-     * cell is alone. Where a neighbour or the buffer ring is, the far field
-     * is held down: for small c, mu = c (2 alpha + 2 lambda sum_{l != k}
-     * c_l^2 + 2 lambda_b b) (b: the node's share of buffer elements), so at
-     * the free far field's chemical potential 2 alpha c_e the node gets
-     * c_e 2 alpha / (that stiffness) (~ c_e / 25 inside a neighbour). The
-     * edge's c_e copied into a neighbour would raise the repulsion energy
-     * at first order. mu: the edge's mean. */
-    double edge_c = 0, edge_mu = 0;
-    int n_edge = 0;
-    for (int i = 0; i < nn; ++i) {
-      int p = sp_layout_pair(layout, k, i);
-      if (p >= 0 && on_edge(s, layout, k, i)) {
-        edge_c += state[2 * p];
-        edge_mu += state[2 * p + 1];
-        ++n_edge;
-      }
+  /* Per cell (every loop below runs over pairs, not cells x nodes):
+   * the old support's edge means of c and mu, then the interior's and the
+   * support's weights. */
+  double *acc = calloc(4 * (size_t)(nc ? nc : 1), sizeof(double));
+  int *n_edge = calloc((size_t)(nc ? nc : 1), sizeof(int));
+  double *w = malloc(sizeof(double) * (size_t)(to->n_pairs ? to->n_pairs : 1));
+  if (!acc || !n_edge || !w) rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
+  double *edge_c = acc, *edge_mu = acc + nc, *w_interior = acc + 2 * (size_t)nc,
+         *w_all = acc + 3 * (size_t)nc;
+  for (int i = 0; i < nn && rc == SP_OK; ++i)
+    for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p) {
+      const int k = layout->pair_cell[p];
+      if (!on_edge(s, layout, k, i)) continue;
+      edge_c[k] += state[2 * p];
+      edge_mu[k] += state[2 * p + 1];
+      ++n_edge[k];
     }
-    if (n_edge) {
-      edge_c /= n_edge;
-      edge_mu /= n_edge;
+  for (int k = 0; k < nc && rc == SP_OK; ++k)
+    if (n_edge[k]) {
+      edge_c[k] /= n_edge[k];
+      edge_mu[k] /= n_edge[k];
     }
-    for (int i = 0; i < nn; ++i) {
-      int q = sp_layout_pair(to, k, i);
-      if (q < 0 || sp_layout_pair(layout, k, i) >= 0) continue;
+  /* New nodes continue the far field: the old edge's mean c_e where the
+   * cell is alone. Where a neighbour or the buffer ring is, the far field
+   * is held down: for small c, mu = c (2 alpha + 2 lambda sum_{l != k}
+   * c_l^2 + 2 lambda_b b) (b: the node's share of buffer elements), so at
+   * the free far field's chemical potential 2 alpha c_e the node gets
+   * c_e 2 alpha / (that stiffness) (~ c_e / 25 inside a neighbour). The
+   * edge's c_e copied into a neighbour would raise the repulsion energy
+   * at first order. mu: the edge's mean. */
+  for (int i = 0; i < nn && rc == SP_OK; ++i)
+    for (int q = to->node_start[i]; q < to->node_start[i + 1]; ++q) {
+      const int k = to->pair_cell[q];
+      if (sp_layout_pair(layout, k, i) >= 0) continue;
       double others = 0; /* sum over l != k of c_l^2 at node i (old state) */
       for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p)
         if (layout->pair_cell[p] != k) others += state[2 * p] * state[2 * p];
       const double free_stiffness = 2 * s->params.alpha;
       const double stiffness = free_stiffness + 2 * s->params.lambda * others +
                                2 * s->params.lambda_b * buffer_share(s, i);
-      next[2 * q] = stiffness > 0 ? edge_c * free_stiffness / stiffness : edge_c;
-      next[2 * q + 1] = edge_mu;
+      next[2 * q] = stiffness > 0 ? edge_c[k] * free_stiffness / stiffness : edge_c[k];
+      next[2 * q + 1] = edge_mu[k];
     }
-  }
-  rc = sp_cells_observe(s->mesh, layout, state, 0.0, before);
+  if (rc == SP_OK) rc = sp_cells_observe(s->mesh, layout, state, 0.0, before);
   if (rc == SP_OK) rc = sp_cells_observe(s->mesh, to, next, 0.0, after);
-  double *w = NULL;
-  if (rc == SP_OK && !(w = malloc(sizeof(double) * (size_t)nn)))
-    rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
+  /* A shift of c_k by d on a set of nodes changes the mass by d x (their
+   * weights) exactly. It goes on the cell's interior (c_k >= 1/2): there
+   * no other cell and no buffer ring is (a shift where a neighbour or the
+   * ring is raises the repulsion or buffer energy at first order) and
+   * f'(c) ~ 0; a cell without interior nodes takes it over its support. */
+  if (rc == SP_OK) rc = sp_cells_pair_weights(s->mesh, to, w);
+  for (int q = 0; q < to->n_pairs && rc == SP_OK; ++q) {
+    const int k = to->pair_cell[q];
+    w_all[k] += w[q];
+    if (next[2 * q] >= SP_SUPPORT_INTERIOR) w_interior[k] += w[q];
+  }
   for (int k = 0; k < nc && rc == SP_OK; ++k) {
-    /* A shift of c_k by d on a set of nodes changes the mass by d x (their
-     * weights) exactly. It goes on the cell's interior (c_k >= 1/2): there
-     * no other cell and no buffer ring is (a shift where a neighbour or the
-     * ring is raises the repulsion or buffer energy at first order) and
-     * f'(c) ~ 0; a cell without interior nodes takes it over its support. */
     const double change = after[k].mass - before[k].mass;
     const double rel = before[k].mass != 0 ? fabs(change / before[k].mass) : fabs(change);
     if (rel > *mass_correction) *mass_correction = rel;
-    rc = sp_cells_node_weights(s->mesh, to, k, w);
-    double w_interior = 0, w_all = 0;
-    for (int i = 0; i < nn && rc == SP_OK; ++i) {
-      const int q = sp_layout_pair(to, k, i);
-      if (q < 0) continue;
-      w_all += w[i];
-      if (next[2 * q] >= SP_SUPPORT_INTERIOR) w_interior += w[i];
-    }
-    const int interior = w_interior > 0;
-    const double weight = interior ? w_interior : w_all;
-    const double shift = weight > 0 ? -change / weight : 0.0;
-    for (int i = 0; i < nn && rc == SP_OK; ++i) {
-      const int q = sp_layout_pair(to, k, i);
-      if (q >= 0 && (!interior || next[2 * q] >= SP_SUPPORT_INTERIOR)) next[2 * q] += shift;
-    }
+    /* the shift of cell k, kept in w_all[k]; w_interior[k] > 0 marks an
+     * interior to shift (a cell without one shifts its whole support) */
+    const double weight = w_interior[k] > 0 ? w_interior[k] : w_all[k];
+    w_all[k] = weight > 0 ? -change / weight : 0.0;
   }
+  for (int q = 0; q < to->n_pairs && rc == SP_OK; ++q) {
+    const int k = to->pair_cell[q];
+    if (w_interior[k] <= 0 || next[2 * q] >= SP_SUPPORT_INTERIOR) next[2 * q] += w_all[k];
+  }
+  free(acc);
+  free(n_edge);
   free(w);
   free(before);
   free(after);
