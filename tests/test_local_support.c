@@ -75,7 +75,8 @@ static sp_run_summary run(const char *scene_file, int n_set, const char **set, c
  * their values except in the interior (c >= 1/2), which alone takes the
  * mass correction; new nodes where the cell is alone all get the old
  * edge's mean c, new nodes inside the neighbour (c_1 > 0.9) at most that x
- * 2 alpha / (2 alpha + 2 lambda 0.81) ~ 1/21. */
+ * 2 alpha / (2 alpha + 2 lambda 0.81) ~ 1/21. The one-pass pair weights
+ * the rebuild uses equal each cell's node weights exactly. */
 static void test_rebuild_growth(void) {
   sp_mesh *mesh;
   CHECK_OK(sp_mesh_rectangle(0, 0, 1, 0.6, 80, 48, &mesh));
@@ -156,6 +157,26 @@ static void test_rebuild_growth(void) {
   for (int k = 0; k < 2; ++k)
     CHECK(fabs(after[k].mass - before[k].mass) <= 1e-13 * before[k].mass,
           "cell %d mass %.17g -> %.17g", k + 1, before[k].mass, after[k].mass);
+  /* the rebuild's one-pass pair weights are each cell's node weights, and
+   * sum_p w_p c_p is the cell's mass */
+  double *w_pair = malloc(sizeof(double) * (size_t)grown->n_pairs);
+  double *w_node = malloc(sizeof(double) * (size_t)nn);
+  CHECK_OK(sp_cells_pair_weights(mesh, grown, w_pair));
+  int weights_differ = 0;
+  for (int k = 0; k < 2; ++k) {
+    CHECK_OK(sp_cells_node_weights(mesh, grown, k, w_node));
+    double mass = 0;
+    for (int i = 0; i < nn; ++i) {
+      const int p = sp_layout_pair(grown, k, i);
+      weights_differ += p >= 0 ? w_pair[p] != w_node[i] : w_node[i] != 0.0;
+      if (p >= 0) mass += w_pair[p] * next[2 * p];
+    }
+    CHECK(fabs(mass - after[k].mass) <= 1e-13 * after[k].mass,
+          "cell %d: sum w c = %.17g, mass %.17g", k + 1, mass, after[k].mass);
+  }
+  CHECK(weights_differ == 0, "%d pair weights differ from the cells' node weights",
+        weights_differ);
+  free(w_pair); free(w_node);
   free(state); free(st); free(next); free(mask);
   sp_layout_destroy(&full); sp_layout_destroy(&layout); sp_layout_destroy(&grown);
   sp_support_destroy(&s_narrow); sp_support_destroy(&s_wide);
