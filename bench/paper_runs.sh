@@ -70,7 +70,10 @@ done
 if [ -f out/paper/growth_12/cells.csv ] && [ -f out/paper/growth_shape_12/cells.csv ]; then
   echo "== run 4 (shape penalty) against run 2"
   echo "   | run | cells | final energy (shape part) | largest energy | mean spike height | mean spike width | mean sqrt(I1/I2) | largest sqrt(I1/I2) | interiors / Omega |"
-  for run in growth_12 growth_shape_12 growth_shape_strong_12 growth_shape_implicit_12; do
+  # (also out/paper/growth_shape_12_implicit and growth_shape_implicit_2e5
+  # when present: the commands are in docs/paper-runs.md)
+  for run in growth_12 growth_shape_12 growth_shape_strong_12 growth_shape_implicit_12 \
+             growth_shape_12_implicit growth_shape_implicit_2e5; do
     out=out/paper/$run
     [ -f "$out/cells.csv" ] || continue
     e=$(awk -F, 'NR > 1 { last = $6; shape = $11; if ($6 > peak) peak = $6 } END { printf "%.4g (%.3g) | %.4g", last, shape, peak }' "$out/energy.csv")
@@ -90,8 +93,9 @@ if [ -f out/paper/growth_12/cells.csv ] && [ -f out/paper/growth_shape_12/cells.
       END { s = 0; m = 0; for (k = 1; k <= n[last]; ++k) { s += r[last, k]; if (r[last, k] > m) m = r[last, k] }
             printf "%d | %.3f | %.3f", n[last], s / n[last], m }' "$out/cells.csv")
     cells=${a%% *}
+    # every run-4 variant has run 2's mesh
     omega=$(sed -n 's/.*semi_x: *\([0-9.e+-]*\), *semi_y: *\([0-9.e+-]*\).*/\1 \2/p' \
-      "inputs/paper/$run.yaml" | awk '{ printf "%.10g", 3.14159265358979 * $1 * $2 }')
+      inputs/paper/growth_12.yaml | awk '{ printf "%.10g", 3.14159265358979 * $1 * $2 }')
     covered=$(awk -F, -v omega="$omega" 'NR == 1 { has = $11 == "area"; next }
       { last = $1; area[$1] += $11 } END { if (has) printf "%.3f", area[last] / omega; else printf "-" }' \
       "$out/cells.csv")
