@@ -10,6 +10,7 @@
 #include "check.h"
 #include "division.h"
 #include "error.h"
+#include "fixtures.h"
 #include "layout.h"
 #include "mesh.h"
 #include "q1.h"
@@ -27,18 +28,16 @@ static double interface_width(void) { return sqrt(1e-3 / 8.0); }
  *  centred at (x, y), on a background b_c (no noise); mu_k = 0.1 (so the
  *  split of mu is visible). The profile is symmetric under both reflections
  *  of the ellipse, so its principal axes are exactly the ellipse's. */
-static void set_ellipse(const sp_mesh *mesh, const sp_layout *layout, double *state, int k,
-                        double x, double y, double a, double b, double phi, double background) {
-  const double d = interface_width(), cs = cos(phi), sn = sin(phi);
+static void set_ellipse_bg(const sp_mesh *mesh, const sp_layout *layout, double *state, int k,
+                           double x, double y, double a, double b, double phi,
+                           double background) {
+  /* eps = d / b in rho units: (rho - 1) b is the distance to the boundary
+   * near the minor axis (fixtures.h) */
+  set_ellipse(mesh, layout, state, k, x, y, a, b, phi, interface_width() / b);
   for (int i = 0; i < mesh->n_nodes; ++i) {
     const int p = sp_layout_pair(layout, k, i);
     if (p < 0) continue;
-    const double dx = mesh->xy[2 * i] - x, dy = mesh->xy[2 * i + 1] - y;
-    const double u = cs * dx + sn * dy, v = -sn * dx + cs * dy;
-    /* (rho - 1) b is the distance to the boundary near the minor axis */
-    const double rho = sqrt((u / a) * (u / a) + (v / b) * (v / b));
-    const double profile = 1.0 / (1.0 + exp((rho - 1.0) * b / d));
-    state[2 * p] = profile + (1.0 - profile) * background;
+    state[2 * p] += (1.0 - state[2 * p]) * background;
     state[2 * p + 1] = 0.1;
   }
 }
@@ -66,7 +65,7 @@ static void test_axis_of_ellipses(void) {
   double worst = 0;
   for (size_t j = 0; j < sizeof orientations / sizeof *orientations; ++j) {
     const double phi = orientations[j];
-    set_ellipse(mesh, layout, state, 0, xc, yc, 0.12, 0.06, phi, 0.0);
+    set_ellipse_bg(mesh, layout, state, 0, xc, yc, 0.12, 0.06, phi, 0.0);
     sp_cell_obs obs;
     CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, &obs));
     double px, py, dx, dy;
@@ -138,8 +137,8 @@ static double check_split(const sp_mesh *mesh, const double *w, double x, double
   CHECK_OK(sp_layout_create_full(mesh->n_nodes, 3, &new_layout));
   double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
   double *new_state = calloc(2 * (size_t)new_layout->n_pairs, sizeof(double));
-  set_ellipse(mesh, layout, state, 0, x, y, 0.12, 0.06, phi, background);
-  set_ellipse(mesh, layout, state, 1, 0.2, 0.8, 0.08, 0.08, 0.0, background);
+  set_ellipse_bg(mesh, layout, state, 0, x, y, 0.12, 0.06, phi, background);
+  set_ellipse_bg(mesh, layout, state, 1, 0.2, 0.8, 0.08, 0.08, 0.0, background);
   sp_cell_obs before[2], after[3];
   CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, before));
   const double width = interface_width();
@@ -272,8 +271,8 @@ static void test_split_local_supports(void) {
   double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
   double *new_state = calloc(2 * (size_t)new_layout->n_pairs, sizeof(double));
   double *bad_state = calloc(2 * (size_t)bad_layout->n_pairs, sizeof(double));
-  set_ellipse(mesh, layout, state, 0, 0.51, 0.49, 0.12, 0.06, 1.0, 0.02);
-  set_ellipse(mesh, layout, state, 1, 0.15, 0.8, 0.08, 0.08, 0.0, 0.02);
+  set_ellipse_bg(mesh, layout, state, 0, 0.51, 0.49, 0.12, 0.06, 1.0, 0.02);
+  set_ellipse_bg(mesh, layout, state, 1, 0.15, 0.8, 0.08, 0.08, 0.0, 0.02);
   sp_cell_obs before[2], after[3];
   CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, before));
   for (int smooth = 0; smooth <= 1; ++smooth) {
@@ -489,7 +488,7 @@ static void test_equal_mass_line(void) {
       if (egg)
         set_egg(mesh, layout, state, 0.42, 0.45, 0.7, 0.01);
       else
-        set_ellipse(mesh, layout, state, 0, 0.5, 0.5, 0.12, 0.06, 0.3, 0.01);
+        set_ellipse_bg(mesh, layout, state, 0, 0.5, 0.5, 0.12, 0.06, 0.3, 0.01);
       sp_cell_obs before, after[2];
       CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, &before));
       double unequal[2], offset = 0;

@@ -17,9 +17,8 @@
 
 #include "check.h"
 #include "division.h"
-#include "fixtures.h"
 #include "scene.h"
-#include "shape.h"
+#include "shape_fixtures.h"
 
 #define PI 3.14159265358979323846
 
@@ -138,13 +137,8 @@ static void test_derivatives(void) {
   double worst[2] = {0, 0}, scale[2] = {0, 0};
   for (int j = 0; j < mesh->n_nodes; j += 7) {
     const int p = sp_layout_pair(layout, 0, j);
-    const double c0 = state[2 * p];
     sp_cell_obs plus, minus;
-    state[2 * p] = c0 + step;
-    CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &plus));
-    state[2 * p] = c0 - step;
-    CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &minus));
-    state[2 * p] = c0;
+    observe_plus_minus(mesh, layout, state, p, step, &plus, &minus);
     const double fd[2] = {(plus.I1 - minus.I1) / (2 * step), (plus.I2 - minus.I2) / (2 * step)};
     const double an[2] = {node_integral_ihat(mesh, j, obs.xc, obs.yc, obs.v1),
                           node_integral_ihat(mesh, j, obs.xc, obs.yc, obs.v2)};
@@ -177,15 +171,7 @@ static void test_derivatives(void) {
   double worst_e = 0, scale_e = 0, worst_c = 0;
   for (int j = 0; j < mesh->n_nodes; j += 7) {
     const int p = sp_layout_pair(layout, 0, j);
-    const double c0 = state[2 * p];
-    sp_cell_obs plus, minus;
-    state[2 * p] = c0 + step;
-    CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &plus));
-    state[2 * p] = c0 - step;
-    CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &minus));
-    state[2 * p] = c0;
-    const double dE = (sp_shape_energy(1, &plus, &birth, delta1, delta2) -
-                       sp_shape_energy(1, &minus, &birth, delta1, delta2)) / (2 * step);
+    const double dE = shape_energy_fd(mesh, layout, state, p, step, &birth, delta1, delta2);
     const double glue = with[2 * p + 1] - without[2 * p + 1];
     worst_e = fmax(worst_e, fabs(glue + dE));
     scale_e = fmax(scale_e, fabs(dE));
@@ -346,41 +332,13 @@ static void test_round(void) {
  *  returns I2 at the end. */
 static double evolve_i2(double delta2, double iref2_factor, int steps, double threshold,
                         double background, double *i2_start, double *i2_ref) {
-  sp_mesh *mesh;
-  sp_layout *layout;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 0.5, 0.5, 64, 64, &mesh));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
-  const size_t n_values = 2 * (size_t)layout->n_pairs;
-  double *state = calloc(n_values, sizeof(double)), *old = malloc(n_values * sizeof(double));
-  const sp_model_params model = paper_model();
-  const double d = sqrt(model.kappa / (2 * model.alpha));
-  /* eps in rho units: the width d across the minor axis */
-  set_ellipse(mesh, layout, state, 0, 0.2517, 0.2489, 0.11, 0.09, 0.0, d / 0.09);
-  for (int p = 0; p < layout->n_pairs; ++p) state[2 * p] += background * (1 - state[2 * p]);
-  sp_cell_obs obs;
-  CHECK_OK(sp_cells_observe(mesh, layout, state, threshold, &obs));
-  const sp_cell_birth birth = {.birth_mass = obs.mass_core,
-                               .Iref = {obs.I1, iref2_factor * obs.I2}};
-  *i2_start = obs.I2;
-  *i2_ref = birth.Iref[1];
-  sp_solver solver = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
-  for (int n = 0; n < steps; ++n) {
-    sp_shape_coef sc;
-    CHECK_OK(sp_shape_coefficients(1, &obs, &birth, 0.0, delta2, &sc));
-    sc.threshold = threshold; /* the term acts where the moments count c */
-    memcpy(old, state, n_values * sizeof(double));
-    sp_step_data data = {.dt = 2e-4, .model = model, .state_old = old,
-                         .shape = delta2 > 0 ? &sc : NULL};
-    sp_step_report rep;
-    CHECK(sp_solver_step(solver, &data, state, &rep) == 0, "step %d: %s", n + 1, rep.reason);
-    CHECK_OK(sp_cells_observe(mesh, layout, state, threshold, &obs));
-  }
-  free(state);
-  free(old);
-  sp_solver_destroy(&solver);
-  sp_layout_destroy(&layout);
-  sp_mesh_destroy(&mesh);
-  return obs.I2;
+  const relax_result r = relax_ellipse((relax_setup){
+      .delta2 = delta2, .iref2_factor = iref2_factor, .threshold = threshold,
+      .background = background, .linear = SP_SOLVER_SUPERLU, .steps = steps, .dt = 2e-4});
+  CHECK(r.ok, "step %d: %s", r.steps_done + 1, r.failed.reason);
+  *i2_start = r.i2_start;
+  *i2_ref = r.i2_ref;
+  return r.i2_end;
 }
 
 /* 4. The sign in the dynamics: I^2 moves toward I^2,ref, with weight

@@ -19,8 +19,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "fixtures.h"
-#include "shape.h"
+#include "shape_fixtures.h"
 
 /* 1. Residual of the implicit term against the energy's derivative. */
 static void test_residual(void) {
@@ -75,15 +74,7 @@ static void test_residual(void) {
   double err_implicit = 0, err_explicit = 0, scale = 0;
   for (int j = 0; j < mesh->n_nodes; j += 7) {
     const int p = sp_layout_pair(layout, 0, j);
-    const double c0 = state[2 * p];
-    sp_cell_obs plus, minus;
-    state[2 * p] = c0 + step;
-    CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &plus));
-    state[2 * p] = c0 - step;
-    CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &minus));
-    state[2 * p] = c0;
-    const double dE = (sp_shape_energy(1, &plus, &birth, delta1, delta2) -
-                       sp_shape_energy(1, &minus, &birth, delta1, delta2)) / (2 * step);
+    const double dE = shape_energy_fd(mesh, layout, state, p, step, &birth, delta1, delta2);
     err_implicit = fmax(err_implicit, fabs(implicit[2 * p + 1] - without[2 * p + 1] + dE));
     err_explicit = fmax(err_explicit, fabs(explicit[2 * p + 1] - without[2 * p + 1] + dE));
     scale = fmax(scale, fabs(dE));
@@ -112,65 +103,11 @@ static void test_residual(void) {
 }
 
 /* An elongated cell (0.11 x 0.09) held toward I2,ref = 0.7 I2 by delta2,
- * no source, `steps` steps of dt; returns the largest relative energy rise
- * (fields + shape) over a step, the Newton history of the first step in
- * *first, and the cell's I2 at the start and end and its reference. */
-typedef struct {
-  int ok, steps_done, newton_its;
-  double rise, i2_start, i2_end, i2_ref, energy_start, energy_end;
-  sp_step_report first;
-} relax_result;
-
+ * moments at c >= 0.05, no background, no source (shape_fixtures.h). */
 static relax_result relax(double delta2, int implicit, int steps, double dt, int linear) {
-  relax_result out = {.ok = 1};
-  sp_mesh *mesh;
-  sp_layout *layout;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 0.5, 0.5, 64, 64, &mesh));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
-  const size_t n_values = 2 * (size_t)layout->n_pairs;
-  double *state = calloc(n_values, sizeof(double)), *old = malloc(n_values * sizeof(double));
-  const sp_model_params model = paper_model();
-  const double d = sqrt(model.kappa / (2 * model.alpha)), threshold = 0.05;
-  set_ellipse(mesh, layout, state, 0, 0.2517, 0.2489, 0.11, 0.09, 0.0, d / 0.09);
-  sp_cell_obs obs;
-  CHECK_OK(sp_cells_observe(mesh, layout, state, threshold, &obs));
-  const sp_cell_birth birth = {.birth_mass = obs.mass_core, .Iref = {obs.I1, 0.7 * obs.I2}};
-  out.i2_start = obs.I2;
-  out.i2_ref = birth.Iref[1];
-  sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, linear);
-  double energy = energy_total(solver, &model, state) +
-                  sp_shape_energy(1, &obs, &birth, 0.0, delta2);
-  out.energy_start = energy;
-  for (int n = 0; n < steps; ++n) {
-    sp_shape_coef sc;
-    CHECK_OK(sp_shape_coefficients(1, &obs, &birth, 0.0, delta2, &sc));
-    sc.threshold = threshold;
-    memcpy(old, state, n_values * sizeof(double));
-    sp_step_data data = {.dt = dt, .model = model, .state_old = old, .shape = &sc,
-                         .shape_implicit = implicit};
-    sp_step_report rep;
-    const int rc = sp_solver_step(solver, &data, state, &rep);
-    if (n == 0) out.first = rep;
-    if (rc != 0) {
-      out.ok = 0;
-      break;
-    }
-    out.newton_its += rep.newton_its;
-    CHECK_OK(sp_cells_observe(mesh, layout, state, threshold, &obs));
-    const double e = energy_total(solver, &model, state) +
-                     sp_shape_energy(1, &obs, &birth, 0.0, delta2);
-    out.rise = fmax(out.rise, (e - energy) / fabs(energy));
-    energy = e;
-    ++out.steps_done;
-  }
-  out.energy_end = energy;
-  out.i2_end = obs.I2;
-  free(state);
-  free(old);
-  sp_solver_destroy(&solver);
-  sp_layout_destroy(&layout);
-  sp_mesh_destroy(&mesh);
-  return out;
+  return relax_ellipse((relax_setup){.delta2 = delta2, .iref2_factor = 0.7, .threshold = 0.05,
+                                     .implicit = implicit, .linear = linear, .steps = steps,
+                                     .dt = dt});
 }
 
 /* 2. Newton's order with the low-rank Jacobian, with serial SuperLU and

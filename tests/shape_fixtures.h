@@ -1,0 +1,115 @@
+/* Shared set-up of the shape-penalty tests (test_shape.c,
+ * test_shape_implicit.c): the central difference of the shape energy in one
+ * nodal value, and an elongated cell relaxing under the penalty. */
+#ifndef SP_TEST_SHAPE_FIXTURES_H
+#define SP_TEST_SHAPE_FIXTURES_H
+#include <string.h>
+
+#include "fixtures.h"
+#include "shape.h"
+
+/** The observables (threshold 0) with the nodal c of pair @p p moved by
+ *  +step and -step; the state is restored. */
+static inline void observe_plus_minus(const sp_mesh *mesh, const sp_layout *layout,
+                                      double *state, int p, double step, sp_cell_obs *plus,
+                                      sp_cell_obs *minus) {
+  const double c0 = state[2 * p];
+  state[2 * p] = c0 + step;
+  CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, plus));
+  state[2 * p] = c0 - step;
+  CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, minus));
+  state[2 * p] = c0;
+}
+
+/** dE_shape/dc_p by a central difference of step @p step in the nodal value
+ *  of pair @p p (cell 0, moments counting every c: threshold 0). */
+static inline double shape_energy_fd(const sp_mesh *mesh, const sp_layout *layout,
+                                     double *state, int p, double step,
+                                     const sp_cell_birth *birth, double delta1,
+                                     double delta2) {
+  sp_cell_obs plus, minus;
+  observe_plus_minus(mesh, layout, state, p, step, &plus, &minus);
+  return (sp_shape_energy(1, &plus, birth, delta1, delta2) -
+          sp_shape_energy(1, &minus, birth, delta1, delta2)) / (2 * step);
+}
+
+/** An elongated cell relaxing under the penalty (relax_ellipse). */
+typedef struct {
+  double delta2;       /**< delta1 = 0 */
+  double iref2_factor; /**< I2,ref = this x the cell's I2 at the start */
+  double threshold;    /**< the moments count c >= this (and the term acts there) */
+  double background;   /**< c += background (1 - c) */
+  int implicit;        /**< sp_step_data.shape_implicit */
+  int linear;          /**< SP_SOLVER_SUPERLU, ... */
+  int steps;
+  double dt;
+} relax_setup;
+
+typedef struct {
+  int ok;                  /**< every step converged */
+  int steps_done, newton_its;
+  double rise;             /**< largest relative energy rise (fields + shape) over a step */
+  double i2_start, i2_end, i2_ref, energy_start, energy_end;
+  sp_step_report first;    /**< the first step's report */
+  sp_step_report failed;   /**< the failed step's report (when !ok) */
+} relax_result;
+
+/** A 0.11 x 0.09 tanh ellipse (width d across its minor axis) on a 64 x 64
+ *  mesh of [0, 0.5]^2, no source, steps of dt with the shape coefficients
+ *  of each c^n (shape term off when delta2 = 0); stops at a failed step. */
+static inline relax_result relax_ellipse(relax_setup r) {
+  relax_result out = {.ok = 1};
+  sp_mesh *mesh;
+  sp_layout *layout;
+  CHECK_OK(sp_mesh_rectangle(0, 0, 0.5, 0.5, 64, 64, &mesh));
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
+  const size_t n_values = 2 * (size_t)layout->n_pairs;
+  double *state = calloc(n_values, sizeof(double)), *old = malloc(n_values * sizeof(double));
+  const sp_model_params model = paper_model();
+  const double d = sqrt(model.kappa / (2 * model.alpha));
+  /* eps in rho units: the width d across the minor axis */
+  set_ellipse(mesh, layout, state, 0, 0.2517, 0.2489, 0.11, 0.09, 0.0, d / 0.09);
+  for (int p = 0; p < layout->n_pairs; ++p) state[2 * p] += r.background * (1 - state[2 * p]);
+  sp_cell_obs obs;
+  CHECK_OK(sp_cells_observe(mesh, layout, state, r.threshold, &obs));
+  const sp_cell_birth birth = {.birth_mass = obs.mass_core,
+                               .Iref = {obs.I1, r.iref2_factor * obs.I2}};
+  out.i2_start = obs.I2;
+  out.i2_ref = birth.Iref[1];
+  sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, r.linear);
+  double energy = energy_total(solver, &model, state) +
+                  sp_shape_energy(1, &obs, &birth, 0.0, r.delta2);
+  out.energy_start = energy;
+  for (int n = 0; n < r.steps; ++n) {
+    sp_shape_coef sc;
+    CHECK_OK(sp_shape_coefficients(1, &obs, &birth, 0.0, r.delta2, &sc));
+    sc.threshold = r.threshold; /* the term acts where the moments count c */
+    memcpy(old, state, n_values * sizeof(double));
+    sp_step_data data = {.dt = r.dt, .model = model, .state_old = old,
+                         .shape = r.delta2 > 0 ? &sc : NULL, .shape_implicit = r.implicit};
+    sp_step_report rep;
+    const int rc = sp_solver_step(solver, &data, state, &rep);
+    if (n == 0) out.first = rep;
+    if (rc != 0) {
+      out.ok = 0;
+      out.failed = rep;
+      break;
+    }
+    out.newton_its += rep.newton_its;
+    CHECK_OK(sp_cells_observe(mesh, layout, state, r.threshold, &obs));
+    const double e = energy_total(solver, &model, state) +
+                     sp_shape_energy(1, &obs, &birth, 0.0, r.delta2);
+    out.rise = fmax(out.rise, (e - energy) / fabs(energy));
+    energy = e;
+    ++out.steps_done;
+  }
+  out.energy_end = energy;
+  out.i2_end = obs.I2;
+  free(state);
+  free(old);
+  sp_solver_destroy(&solver);
+  sp_layout_destroy(&layout);
+  sp_mesh_destroy(&mesh);
+  return out;
+}
+#endif
