@@ -24,3 +24,31 @@ stage_pictures() {
     fi
   done
 }
+
+# compare_runs A B: the agreement of run B with run A (two output
+# directories of the same scene): energy at the steps both reached at the
+# same t, cell counts there, every cell's mass and centre at each run's
+# last step, and both lists of divisions.
+compare_runs() {
+  local a=$1 b=$2
+  echo "agreement of $(basename "$b") with $(basename "$a") (energy.csv rows of the same step and t; cells at each run's last step):"
+  awk -F, 'FNR == 1 { next }
+    FILENAME == ARGV[1] { ea[$1] = $6; ta[$1] = $2; na[$1] = $5; next }
+    ($1 in ea) { dt = $2 - ta[$1]; if (dt < 0) dt = -dt; if (dt > 1e-12 * ($2 + 1e-300)) next
+                 matched++; rel = ($6 - ea[$1]) / ea[$1]; if (rel < 0) rel = -rel
+                 if (rel > worst) { worst = rel; at = $1 }
+                 if (na[$1] != $5) cells_differ++ }
+    END { printf "  %d steps matched; largest relative energy difference %.3e (step %d); with a different cell count: %d\n",
+                 matched, worst, at, cells_differ + 0 }' "$a/energy.csv" "$b/energy.csv"
+  local la lb
+  la=$(tail -1 "$a/cells.csv" | cut -d, -f1)
+  lb=$(tail -1 "$b/cells.csv" | cut -d, -f1)
+  awk -F, -v la="$la" -v lb="$lb" 'FNR == 1 { next }
+    FILENAME == ARGV[1] { if ($1 == la) { m[$3] = $4; x[$3] = $5; y[$3] = $6 }; next }
+    $1 == lb { dm = ($4 - m[$3]) / m[$3]; dx = $5 - x[$3]; dy = $6 - y[$3]
+      printf "  cell %d: mass rel. diff %.2e, centre moved by %.2e\n", $3, dm, sqrt(dx*dx + dy*dy) }' \
+    "$a/cells.csv" "$b/cells.csv"
+  echo "divisions ($(basename "$a"), then $(basename "$b")):"
+  cut -d, -f1-5 "$a/divisions.csv" | sed 's/^/  /'
+  cut -d, -f1-5 "$b/divisions.csv" | sed 's/^/  /'
+}

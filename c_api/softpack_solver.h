@@ -48,6 +48,11 @@ typedef struct {
   double newton_rtol;  /**< ||F|| <= rtol ||F_0|| ... */
   double newton_atol;  /**< ... or ||F|| <= atol (unscaled 2-norm) */
   int newton_max_its;  /**< more iterations count as a failure */
+  /** Modified Newton: an iteration keeps the last Jacobian and its
+   *  factorisation when the previous iteration cut ||F|| at least this
+   *  much (||F_k|| <= jacobian_reuse ||F_k-1||); the first iteration of a
+   *  step always has a fresh one. 0: a new Jacobian every iteration. */
+  double jacobian_reuse;
 } sp_solver_options;
 
 /** The mesh, borrowed (must outlive the solver's use of it). */
@@ -113,6 +118,7 @@ typedef struct {
 typedef struct {
   int converged;        /**< 1 only if Newton met its tolerance */
   int newton_its;
+  int factorisations;   /**< Jacobians filled and factored (<= newton_its) */
   int n_residuals;      /**< entries of residual_norms */
   double residual_norms[SP_MAX_NEWTON_HISTORY]; /**< ||F|| per iteration */
   double t_assembly;    /**< seconds: residual + Jacobian fills */

@@ -76,6 +76,7 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   Teuchos::RCP<NOX::Epetra::Scaling> getScaling() override { return Teuchos::null; }
   void resetScaling(const Teuchos::RCP<NOX::Epetra::Scaling> &) override {}
   bool computeJacobian(const NOX::Epetra::Vector &x) override {
+    if (s_.may_reuse_jacobian()) return true;  // keep matrix and factors
     return i_.computeJacobian(x.getEpetraVector(), *s_.jacobian_matrix);
   }
   bool createPreconditioner(const NOX::Epetra::Vector &, Teuchos::ParameterList &,
@@ -106,15 +107,17 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
 // Records ||F|| at the start and after every iteration.
 class ResidualRecorder : public NOX::Observer {
  public:
-  explicit ResidualRecorder(sp_step_report &r) : r_(r) {}
+  ResidualRecorder(Solver &s, sp_step_report &r) : s_(s), r_(r) {}
   void runPreSolve(const NOX::Solver::Generic &solver) override { record(solver); }
   void runPostIterate(const NOX::Solver::Generic &solver) override { record(solver); }
 
  private:
   void record(const NOX::Solver::Generic &solver) {
-    if (r_.n_residuals < SP_MAX_NEWTON_HISTORY)
-      r_.residual_norms[r_.n_residuals++] = solver.getSolutionGroup().getNormF();
+    const double norm = solver.getSolutionGroup().getNormF();
+    s_.note_residual(norm);
+    if (r_.n_residuals < SP_MAX_NEWTON_HISTORY) r_.residual_norms[r_.n_residuals++] = norm;
   }
+  Solver &s_;
   sp_step_report &r_;
 };
 
@@ -139,12 +142,39 @@ class AtLeastOneIteration : public NOX::StatusTest::Generic {
   NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unevaluated;
 };
 
+// Modified Newton's iteration limit: this many factorisations (each
+// iteration that reused one was cheap, and followed one that cut ||F|| by
+// jacobian_reuse).
+class FactorisationLimit : public NOX::StatusTest::Generic {
+ public:
+  FactorisationLimit(const Solver &s, int limit) : s_(s), limit_(limit) {}
+  NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic &,
+                                          NOX::StatusTest::CheckType) override {
+    status_ = s_.step_factorisations() >= limit_ ? NOX::StatusTest::Failed
+                                                 : NOX::StatusTest::Unconverged;
+    return status_;
+  }
+  NOX::StatusTest::StatusType getStatus() const override { return status_; }
+  std::ostream &print(std::ostream &s, int indent) const override {
+    for (int i = 0; i < indent; ++i) s << ' ';
+    s << status_ << "Factorisations < " << limit_ << "\n";
+    return s;
+  }
+
+ private:
+  const Solver &s_;
+  int limit_;
+  NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unevaluated;
+};
+
 }  // namespace
 
 Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     : comm_(comm), options_(options) {
   if (options.jacobian < SP_SOLVER_JAC_AD || options.jacobian > SP_SOLVER_JAC_FD)
     throw std::runtime_error("solver.jacobian: unknown kind");
+  if (!(options.jacobian_reuse >= 0 && options.jacobian_reuse < 1))
+    throw std::runtime_error("solver.jacobian_reuse: expected 0 <= value < 1");
   const int P = comm_.NumProc();
   switch (options.linear) {
     case SP_SOLVER_SUPERLU:
@@ -452,6 +482,13 @@ bool agree(MPI_Comm comm, bool ok, std::string &why) {
 
 }  // namespace
 
+bool Solver::may_reuse_jacobian() const {
+  const size_t n = step_norms_.size();
+  // The norms are global, so every rank decides alike.
+  return options_.jacobian_reuse > 0 && step_factorisations_ > 0 && !jacobian_fresh_ &&
+         !pattern_changed_ && n >= 2 && step_norms_[n - 1] <= options_.jacobian_reuse * step_norms_[n - 2];
+}
+
 bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
   const bool low_rank = !shape_u_.empty();
   if (jacobian_fresh_) {
@@ -480,6 +517,7 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
     }
     pattern_changed_ = false;
     jacobian_fresh_ = false;
+    ++step_factorisations_;
     if (low_rank) {
       t0 = now();
       ok = factor_low_rank(b.Values(), x.Values(), why);
@@ -501,6 +539,8 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   require_problem();
   report = sp_step_report{};
   t_assembly = t_factor = t_solve = 0;
+  step_factorisations_ = 0;
+  step_norms_.clear();
   const double t_start = now();
   const Epetra_Map &map = assembly_->map();
   Epetra_Vector x0(map);
@@ -517,7 +557,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   params->sublist("Printing").set("Output Information", 0);
   params->sublist("Solver Options").set("Status Test Check Type", "Complete");
   params->sublist("Solver Options").set<Teuchos::RCP<NOX::Observer>>(
-      "User Defined Pre/Post Operator", Teuchos::rcp(new ResidualRecorder(report)));
+      "User Defined Pre/Post Operator", Teuchos::rcp(new ResidualRecorder(*this, report)));
   NOX::Epetra::Vector guess(x0, NOX::DeepCopy);
   auto group = Teuchos::rcp(new NOX::Epetra::Group(params->sublist("Printing"), iface, guess, linsys));
 
@@ -531,7 +571,13 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   auto all = Teuchos::rcp(new Combo(Combo::OR));
   all->addStatusTest(Teuchos::rcp(new FiniteValue));
   all->addStatusTest(converged);
-  all->addStatusTest(Teuchos::rcp(new MaxIters(options_.newton_max_its)));
+  // Newton: newton_max_its iterations; modified Newton: as many
+  // factorisations, and at most twice as many iterations.
+  const int max_its = options_.jacobian_reuse > 0 ? 2 * options_.newton_max_its
+                                                  : options_.newton_max_its;
+  if (options_.jacobian_reuse > 0)
+    all->addStatusTest(Teuchos::rcp(new FactorisationLimit(*this, options_.newton_max_its)));
+  all->addStatusTest(Teuchos::rcp(new MaxIters(max_its)));
   all->addStatusTest(Teuchos::rcp(new Divergence(1e30)));
   // The relative test evaluated F at the guess: that fill is not a Newton
   // iteration's work but is counted in assembly all the same.
@@ -540,6 +586,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   last_error.clear();
   StatusType status = solver->solve();
   report.newton_its = solver->getNumIterations();
+  report.factorisations = step_factorisations_;
   report.t_assembly = t_assembly;
   report.t_factor = t_factor;
   report.t_solve = t_solve;
@@ -555,8 +602,10 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   const double last = report.n_residuals ? report.residual_norms[report.n_residuals - 1] : NAN;
   std::string why = !last_error.empty() ? last_error
                     : !std::isfinite(last) ? "the residual is not finite"
-                    : report.newton_its >= options_.newton_max_its
-                        ? "no convergence in " + std::to_string(options_.newton_max_its) + " Newton iterations"
+                    : report.newton_its >= max_its || report.factorisations >= options_.newton_max_its
+                        ? "no convergence in " + std::to_string(report.newton_its) +
+                              " Newton iterations (" + std::to_string(report.factorisations) +
+                              " factorisations)"
                         : "Newton failed";
   snprintf(report.reason, sizeof report.reason, "%s (last |F| = %.3g)", why.c_str(), last);
   report.t_total = now() - t_start;

@@ -43,6 +43,12 @@ class Solver {
   bool solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why);
   // out = J in, J with the implicit shape term's low-rank part.
   bool apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out);
+  // ||F|| after each iteration of the current step (and at its guess).
+  void note_residual(double norm) { step_norms_.push_back(norm); }
+  // Modified Newton (sp_solver_options.jacobian_reuse): whether the next
+  // iteration may keep the factorisation of this step's last Jacobian.
+  bool may_reuse_jacobian() const;
+  int step_factorisations() const { return step_factorisations_; }
 
   std::string last_error;
   Teuchos::RCP<Epetra_FECrsMatrix> jacobian_matrix;
@@ -77,6 +83,8 @@ class Solver {
   std::vector<double> csr_val_;
   bool jacobian_fresh_ = false;  // the matrix changed since the last factor
   bool pattern_changed_ = true;  // the layout changed since the last factor
+  int step_factorisations_ = 0;  // factorisations in the current step
+  std::vector<double> step_norms_;  // ||F|| at the guess and after each iteration
   std::vector<double> full_;     // scratch: the replicated state
   // Implicit shape term of the current step (empty when explicit).
   std::vector<double> shape_u_;            // 2 per pair (Assembly::shape_weights)

@@ -25,17 +25,21 @@ int sp_output_open(const char *dir, sp_output *out);
  *  step (every attempt, divisions, support changes), the solver's phases
  *  and the support change (local supports), whether one happened, and the
  *  unknowns of the Newton system the step solved (2 x the (cell, node)
- *  pairs of the layout before any support change after it). */
+ *  pairs of the layout before any support change after it), the
+ *  factorisations of the accepted attempt (fewer than its Newton
+ *  iterations with solver.jacobian_reuse) and the failed attempts before
+ *  it. */
 typedef struct {
   double step, assembly, factorisation, solves, supports;
   int support_changed;
   long unknowns;
+  int factorisations, failed_attempts;
 } sp_step_costs;
 
 /** @brief Append one row to energy.csv:
  *  step,t,dt,newton_its,n_cells,energy,bulk,gradient,repulsion,buffer,shape,
  *  seconds,assembly_s,factorisation_s,solves_s,supports_s,support_changed,
- *  unknowns
+ *  unknowns,factorisations,failed_attempts
  *  (@p seconds NULL: zeros) */
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,

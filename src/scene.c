@@ -279,7 +279,13 @@ static const sp_key sp_keys[] = {
               "Newton: absolute residual (unscaled 2-norm)"),
     KEY_INT(SP_SEC_SOLVER, "newton_max_its", solver.newton_max_its, 12,
             AT_LEAST(1), AT_MOST(60), "-",
-            "Newton iterations before a step counts as failed"),
+            "Newton iterations (with jacobian_reuse: factorisations, and at "
+            "most twice as many iterations) before a step counts as failed"),
+    KEY_FLOAT(SP_SEC_SOLVER, "jacobian_reuse", solver.jacobian_reuse, 0.0,
+              AT_LEAST(0.0), BELOW(1.0), "-",
+              "modified Newton: an iteration keeps the last Jacobian and its "
+              "factorisation while the previous one cut the residual norm by "
+              "at least this factor (0: a new Jacobian every iteration)"),
     /* output */
     KEY_INT(SP_SEC_OUTPUT, "every", output.every, 10, AT_LEAST(1),
             AT_MOST(INT_MAX), "steps",

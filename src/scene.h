@@ -78,6 +78,8 @@ typedef struct {
   double newton_rtol;  /**< relative residual tolerance */
   double newton_atol;  /**< absolute residual tolerance (unscaled 2-norm) */
   int newton_max_its;  /**< iterations before a step counts as failed */
+  double jacobian_reuse; /**< modified Newton: keep the factorisation while
+                              each iteration cuts ||F|| by this (0: never) */
 } sp_scene_solver;
 
 /** output: what is written and when. */

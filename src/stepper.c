@@ -34,6 +34,7 @@ void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt)
   opt->newton_rtol = scene->solver.newton_rtol;
   opt->newton_atol = scene->solver.newton_atol;
   opt->newton_max_its = scene->solver.newton_max_its;
+  opt->jacobian_reuse = scene->solver.jacobian_reuse;
 }
 
 void sp_model_from_scene(const sp_scene *scene, sp_model_params *model) {
@@ -399,6 +400,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     if (solved == 1) { /* never accept: shrink and retry from the last good state */
       memcpy(run->state, run->state_old, n_values * sizeof(double));
       ++failures;
+      ++seconds.failed_attempts;
       ++sum->failed_attempts;
       successes = 0;
       dt = dt_try * tc->shrink;
@@ -419,6 +421,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     failures = 0;
     sum->steps = step;
     sum->newton_its += report.newton_its;
+    sum->factorisations += report.factorisations;
+    seconds.factorisations = report.factorisations;
     sum->t_final = t;
     if (since_division >= 0) ++since_division;
     if (dt_try < sum->dt_smallest) sum->dt_smallest = dt_try;

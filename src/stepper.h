@@ -24,6 +24,7 @@ typedef struct {
   int steps;           /**< accepted steps */
   int failed_attempts; /**< Newton failures that were retried */
   long newton_its;     /**< Newton iterations of accepted steps */
+  long factorisations; /**< their factorisations (solver.jacobian_reuse) */
   double t_final;      /**< time reached */
   double dt_smallest;  /**< smallest accepted dt */
   double wall_seconds;

@@ -21,13 +21,18 @@ static inline sp_model_params paper_model(void) {
   return m;
 }
 
-/** A solver with direct solver @p linear (SP_SOLVER_*) on the mesh and layout. */
-static inline sp_solver make_solver_with(const sp_mesh *mesh, const sp_layout *layout,
-                                         int jacobian, int linear) {
+/** The tests' Newton options: tight tolerances, a new Jacobian every iteration. */
+static inline sp_solver_options test_options(int jacobian, int linear) {
   sp_solver_options opt = {.jacobian = jacobian, .linear = linear,
                            .newton_rtol = 1e-10, .newton_atol = 1e-11, .newton_max_its = 20};
+  return opt;
+}
+
+/** A solver with @p opt on the mesh and layout. */
+static inline sp_solver make_solver_opts(const sp_mesh *mesh, const sp_layout *layout,
+                                         const sp_solver_options *opt) {
   sp_solver s = NULL;
-  if (sp_solver_create(MPI_COMM_WORLD, &opt, &s) != 0) {
+  if (sp_solver_create(MPI_COMM_WORLD, opt, &s) != 0) {
     fprintf(stderr, "sp_solver_create: %s\n", sp_solver_last_error(s));
     exit(1);
   }
@@ -36,6 +41,13 @@ static inline sp_solver make_solver_with(const sp_mesh *mesh, const sp_layout *l
     exit(1);
   }
   return s;
+}
+
+/** A solver with direct solver @p linear (SP_SOLVER_*) on the mesh and layout. */
+static inline sp_solver make_solver_with(const sp_mesh *mesh, const sp_layout *layout,
+                                         int jacobian, int linear) {
+  sp_solver_options opt = test_options(jacobian, linear);
+  return make_solver_opts(mesh, layout, &opt);
 }
 
 static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout, int jacobian) {
