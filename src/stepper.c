@@ -404,6 +404,13 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       ++sum->failed_attempts;
       successes = 0;
       dt = dt_try * tc->shrink;
+      if (run->rank == 0) { /* what failed, and the retry: no silent retries */
+        fprintf(stderr, "softpack: step %d at t = %.6g, dt = %.3g: %s; |F|:", step + 1, t,
+                dt_try, report.reason);
+        for (int i = 0; i < report.n_residuals; ++i)
+          fprintf(stderr, " %.2e", report.residual_norms[i]);
+        fprintf(stderr, "; retried with dt = %.3g\n", dt);
+      }
       if (failures > tc->max_retries || dt < tc->dt_min) {
         int rc_out = write_snapshot(run, step, t);
         rc = sp_error_set(SP_ERR_SOLVER,

@@ -8,6 +8,7 @@
  *   with solver.newton_max_its = 4 it fails, is retried with a smaller dt
  *   and the run goes on (never accepting the failed step). */
 #include <string.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "error.h"
@@ -57,12 +58,37 @@ int main(int argc, char **argv) {
   const char *set[] = {"division.n_div=0", "division.m=0", "solver.newton_max_its=4"};
   CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 3, set, &scene));
   scene->time.t_end = 0.0046; /* the first division and a few steps */
+  /* stderr to a file: every failed attempt is reported there */
+  fflush(stderr);
+  const int saved = dup(fileno(stderr));
+  CHECK(freopen("hard_retry_stderr.txt", "w", stderr) != NULL, "cannot redirect stderr");
   CHECK_OK(sp_stepper_run(scene, "hard_retry", MPI_COMM_WORLD, &sum));
+  fflush(stderr);
+  dup2(saved, fileno(stderr));
+  close(saved);
   printf("no algorithm 2: %d cells, %d failed attempts retried, smallest dt %.3g\n", sum.n_cells,
          sum.failed_attempts, sum.dt_smallest);
   CHECK(sum.n_cells == 2, "%d cells", sum.n_cells);
   CHECK(sum.failed_attempts >= 1, "Newton never failed after the sharp cut at the full dt");
   CHECK(sum.dt_smallest < scene->time.dt, "smallest dt %g", sum.dt_smallest);
+  int reported = 0, logged = 0;
+  FILE *f = fopen("hard_retry_stderr.txt", "r");
+  char line[2048];
+  while (f && fgets(line, sizeof line, f)) {
+    if (strstr(line, "no convergence in 4 Newton iterations") && strstr(line, "|F|:") &&
+        strstr(line, "retried with dt = ")) {
+      if (reported == 0) printf("reported: %s", line);
+      ++reported;
+    }
+  }
+  if (f) fclose(f);
+  csv_table e;
+  CHECK(csv_read("hard_retry/energy.csv", &e) == 0, "hard_retry/energy.csv unreadable");
+  for (int i = 0; i < e.n_rows; ++i) logged += (int)at(&e, i, "failed_attempts");
+  free(e.v);
+  CHECK(reported == sum.failed_attempts && logged == sum.failed_attempts,
+        "%d failed attempts, %d reported on stderr, %d in energy.csv", sum.failed_attempts,
+        reported, logged);
   sp_scene_destroy(&scene);
   MPI_Finalize();
   TEST_DONE();
