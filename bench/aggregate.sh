@@ -44,19 +44,21 @@ if [ -z "$nodes" ]; then # pieces of an MPI run share nodes: count the mesh on o
 fi
 echo "mesh nodes: $nodes"
 echo
-echo "| cells | steps | Newton its | unknowns (largest) | unknowns / node | s/step | s/step/cell | s/iteration | s/iteration/cell | assembly/it | factorisation/it | solves/it | support changes | s/change | per cell vs 16 (step, iteration) |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| cells | steps | Newton its | factorisations | failed attempts | unknowns (largest) | unknowns / node | s/step | s/step/cell | s/iteration | s/iteration/cell | assembly/it | factorisation/it | solves/it | support changes | s/change | per cell vs 16 (step, iteration) |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 awk -F, -v nodes="$nodes" 'NR == 1 { for (j = 1; j <= NF; ++j) c[$j] = j; next }
   $1 > 0 { n = $c["n_cells"]; if (!(n in steps)) order[++k] = n
     steps[n]++; its[n] += $c["newton_its"]; sec[n] += $c["seconds"]
+    if ("factorisations" in c) { fc[n] += $c["factorisations"]; fl[n] += $c["failed_attempts"] }
     as[n] += $c["assembly_s"]; fa[n] += $c["factorisation_s"]; so[n] += $c["solves_s"]
     ch[n] += $c["support_changed"]; sup[n] += $c["supports_s"]; if ($c["unknowns"] > u[n]) u[n] = $c["unknowns"] }
   END { if (16 in steps) { ref = sec[16] / steps[16] / 16; refit = sec[16] / its[16] / 16 }
     for (i = 1; i <= k; ++i) { n = order[i]
       per = sec[n] / steps[n] / n
       perit = sec[n] / its[n] / n
-      printf "| %d | %d | %d | %d | %.2f | %.3f | %.4f | %.3f | %.4f | %.3f | %.3f | %.3f | %d | %s | %s |\n",
-        n, steps[n], its[n], u[n], u[n] / nodes, sec[n] / steps[n], per, sec[n] / its[n], perit,
+      printf "| %d | %d | %d | %s | %s | %d | %.2f | %.3f | %.4f | %.3f | %.4f | %.3f | %.3f | %.3f | %d | %s | %s |\n",
+        n, steps[n], its[n], ("factorisations" in c) ? fc[n] : "-", ("factorisations" in c) ? fl[n] : "-",
+        u[n], u[n] / nodes, sec[n] / steps[n], per, sec[n] / its[n], perit,
         as[n] / its[n], fa[n] / its[n], so[n] / its[n], ch[n],
         ch[n] ? sprintf("%.3f", sup[n] / ch[n]) : "-",
         ref ? sprintf("%.2f, %.2f", per / ref, perit / refit) : "-" } }' \

@@ -8,6 +8,7 @@
 # dir/local (otherwise a temporary directory, removed at the end).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib.sh
 scene=${1:-inputs/divide_1_2_4.yaml}
 shift || true
 extra=("$@")
@@ -21,21 +22,5 @@ for mode in full local; do
   /usr/bin/time -f "$mode: %e s wall, %M kB peak" "$bin" run "$scene" --out "$out/$mode" \
       --set layout.support=$mode --set output.pictures=false "${sets[@]}" 2>&1 | sed "s/^/$mode: /"
 done
-echo "agreement (energy.csv rows matched by step; cells at the last step):"
-awk -F, 'FNR == 1 { next }
-  FILENAME ~ /full/ { ef[$1] = $6; tf[$1] = $2; nf[$1] = $5; next }
-  ($1 in ef) { rel = ($6 - ef[$1]) / ef[$1]; if (rel < 0) rel = -rel;
-               if (rel > worst) { worst = rel; at = $1 }
-               if (nf[$1] != $5) cells_differ++ }
-  END { printf "  largest relative energy difference %.3e (step %d); steps with a different cell count: %d\n",
-               worst, at, cells_differ + 0 }' "$out/full/energy.csv" "$out/local/energy.csv"
-last=$(tail -1 "$out/full/cells.csv" | cut -d, -f1)
-awk -F, -v last="$last" 'FNR == 1 || $1 != last { next }
-  FILENAME ~ /full/ { m[$3] = $4; x[$3] = $5; y[$3] = $6; next }
-  { dm = ($4 - m[$3]) / m[$3]; dx = $5 - x[$3]; dy = $6 - y[$3];
-    printf "  cell %d: mass rel. diff %.2e, centre moved by %.2e\n", $3, dm, sqrt(dx*dx + dy*dy) }' \
-  "$out/full/cells.csv" "$out/local/cells.csv"
-echo "divisions (full, then local):"
-cut -d, -f1-5 "$out/full/divisions.csv" | sed 's/^/  /'
-cut -d, -f1-5 "$out/local/divisions.csv" | sed 's/^/  /'
+compare_runs "$out/full" "$out/local"
 [ -n "${OUT:-}" ] || rm -rf "$out"

@@ -486,7 +486,8 @@ bool Solver::may_reuse_jacobian() const {
   const size_t n = step_norms_.size();
   // The norms are global, so every rank decides alike.
   return options_.jacobian_reuse > 0 && step_factorisations_ > 0 && !jacobian_fresh_ &&
-         !pattern_changed_ && n >= 2 && step_norms_[n - 1] <= options_.jacobian_reuse * step_norms_[n - 2];
+         !pattern_changed_ && n >= 2 &&
+         step_norms_[n - 1] <= options_.jacobian_reuse * step_norms_[n - 2];
 }
 
 bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
@@ -602,7 +603,8 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   const double last = report.n_residuals ? report.residual_norms[report.n_residuals - 1] : NAN;
   std::string why = !last_error.empty() ? last_error
                     : !std::isfinite(last) ? "the residual is not finite"
-                    : report.newton_its >= max_its || report.factorisations >= options_.newton_max_its
+                    : report.newton_its >= max_its ||
+                              report.factorisations >= options_.newton_max_its
                         ? "no convergence in " + std::to_string(report.newton_its) +
                               " Newton iterations (" + std::to_string(report.factorisations) +
                               " factorisations)"
