@@ -16,6 +16,7 @@
 #     (--reuse: tables and pictures of an earlier run; --set: scene overrides)
 #   NP=2 bench/aggregate.sh         (under mpirun -np 2)
 #   OUT=dir IMG=dir bench/aggregate.sh --reuse   (another run's outputs, pictures elsewhere)
+#   SOFTPACK=path bench/aggregate.sh              (another binary, e.g. a copy)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . bench/lib.sh
@@ -30,7 +31,7 @@ if [ $reuse -eq 0 ]; then
   mkdir -p out
   launch=()
   [ "${NP:-1}" -gt 1 ] && launch=(mpirun --allow-run-as-root --oversubscribe -np "$NP")
-  /usr/bin/time -f "wall %e s, peak %M kB (rank 0)" "${launch[@]}" build/softpack run "$scene" \
+  /usr/bin/time -f "wall %e s, peak %M kB (rank 0)" "${launch[@]}" "${SOFTPACK:-build/softpack}" run "$scene" \
       --out "$out" "$@" > "$out.log" 2>&1
 fi
 [ -f "$out/energy.csv" ] || { echo "bench/aggregate.sh: no $out/energy.csv (run without --reuse)" >&2; exit 2; }
@@ -44,24 +45,26 @@ if [ -z "$nodes" ]; then # pieces of an MPI run share nodes: count the mesh on o
 fi
 echo "mesh nodes: $nodes"
 echo
-echo "| cells | steps | Newton its | factorisations | failed attempts | unknowns (largest) | unknowns / node | s/step | s/step/cell | s/iteration | s/iteration/cell | assembly/it | factorisation/it | solves/it | support changes | s/change | per cell vs 16 (step, iteration) |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| cells | steps | Newton its | factorisations | failed attempts | unknowns (largest) | unknowns / node | s/step | s/step/cell | s/iteration | s/iteration/cell | assembly/it | factorisation/it | solves/it | support changes | s/change | s per 1e-4 of t per cell | per cell vs 16 (step, iteration, t) |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 awk -F, -v nodes="$nodes" 'NR == 1 { for (j = 1; j <= NF; ++j) c[$j] = j; next }
   $1 > 0 { n = $c["n_cells"]; if (!(n in steps)) order[++k] = n
-    steps[n]++; its[n] += $c["newton_its"]; sec[n] += $c["seconds"]
+    steps[n]++; its[n] += $c["newton_its"]; sec[n] += $c["seconds"]; simt[n] += $c["dt"]
     if ("factorisations" in c) { fc[n] += $c["factorisations"]; fl[n] += $c["failed_attempts"] }
     as[n] += $c["assembly_s"]; fa[n] += $c["factorisation_s"]; so[n] += $c["solves_s"]
     ch[n] += $c["support_changed"]; sup[n] += $c["supports_s"]; if ($c["unknowns"] > u[n]) u[n] = $c["unknowns"] }
-  END { if (16 in steps) { ref = sec[16] / steps[16] / 16; refit = sec[16] / its[16] / 16 }
+  END { if (16 in steps) { ref = sec[16] / steps[16] / 16; refit = sec[16] / its[16] / 16
+                           reft = sec[16] / simt[16] / 16 }
     for (i = 1; i <= k; ++i) { n = order[i]
       per = sec[n] / steps[n] / n
       perit = sec[n] / its[n] / n
-      printf "| %d | %d | %d | %s | %s | %d | %.2f | %.3f | %.4f | %.3f | %.4f | %.3f | %.3f | %.3f | %d | %s | %s |\n",
+      pert = sec[n] / simt[n] / n
+      printf "| %d | %d | %d | %s | %s | %d | %.2f | %.3f | %.4f | %.3f | %.4f | %.3f | %.3f | %.3f | %d | %s | %.3g | %s |\n",
         n, steps[n], its[n], ("factorisations" in c) ? fc[n] : "-", ("factorisations" in c) ? fl[n] : "-",
         u[n], u[n] / nodes, sec[n] / steps[n], per, sec[n] / its[n], perit,
         as[n] / its[n], fa[n] / its[n], so[n] / its[n], ch[n],
-        ch[n] ? sprintf("%.3f", sup[n] / ch[n]) : "-",
-        ref ? sprintf("%.2f, %.2f", per / ref, perit / refit) : "-" } }' \
+        ch[n] ? sprintf("%.3f", sup[n] / ch[n]) : "-", 1e-4 * pert,
+        ref ? sprintf("%.2f, %.2f, %.2f", per / ref, perit / refit, pert / reft) : "-" } }' \
   "$out/energy.csv"
 echo
 echo "(steps with N cells include the ramp of algorithm 2 after each division: tiny steps of 2-3 iterations)"

@@ -253,6 +253,10 @@ static const sp_key sp_keys[] = {
     KEY_INT(SP_SEC_TIME, "max_retries", time.max_retries, 30, AT_LEAST(1),
             AT_MOST(1000), "-",
             "failed attempts of one step before the run stops"),
+    KEY_INT(SP_SEC_TIME, "failure_memory", time.failure_memory, 0, AT_LEAST(0),
+            AT_MOST(INT_MAX), "steps",
+            "after a failed attempt at dt_f, dt stays <= dt_f / grow for this "
+            "many accepted steps (0: it grows back to dt_f after grow_after)"),
     /* noise */
     KEY_FLOAT(SP_SEC_NOISE, "background", noise.background, 0.0,
               AT_LEAST(0.0), AT_MOST(1.0), "-",

@@ -55,6 +55,8 @@ typedef struct {
   double grow;      /**< dt factor after grow_after successes (> 1) */
   int grow_after;   /**< consecutive successes before dt grows */
   int max_retries;  /**< failed attempts of one step before the run stops */
+  int failure_memory; /**< accepted steps after a failure at dt_f during
+                           which dt stays <= dt_f / grow (0: none) */
 } sp_scene_time;
 
 /** One initial cell. */

@@ -341,6 +341,9 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   double t = 0.0, dt = tc->dt;
   int step = 0, successes = 0, failures = 0;
   int since_division = -1; /* steps since the last division; -1: none yet */
+  /* time.failure_memory: dt's ceiling after a failure, for so many steps */
+  double dt_ceiling = tc->dt;
+  int ceiling_steps = 0;
   double *core_mass_old = NULL;
   sum->dt_smallest = tc->dt;
   SP_CALL(record_energy(run, 0, t, 0.0, 0, NULL, NULL));
@@ -404,6 +407,10 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       ++sum->failed_attempts;
       successes = 0;
       dt = dt_try * tc->shrink;
+      if (tc->failure_memory > 0) {
+        dt_ceiling = fmax(dt, dt_try / tc->grow);
+        ceiling_steps = tc->failure_memory;
+      }
       if (run->rank == 0) { /* what failed, and the retry: no silent retries */
         fprintf(stderr, "softpack: step %d at t = %.6g, dt = %.3g: %s; |F|:", step + 1, t,
                 dt_try, report.reason);
@@ -433,8 +440,10 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     sum->t_final = t;
     if (since_division >= 0) ++since_division;
     if (dt_try < sum->dt_smallest) sum->dt_smallest = dt_try;
-    if (++successes >= tc->grow_after && dt < tc->dt) {
-      dt = fmin(dt * tc->grow, tc->dt);
+    if (ceiling_steps > 0) --ceiling_steps;
+    const double dt_max = ceiling_steps > 0 ? fmin(tc->dt, dt_ceiling) : tc->dt;
+    if (++successes >= tc->grow_after && dt < dt_max) {
+      dt = fmin(dt * tc->grow, dt_max);
       successes = 0;
     }
     /* the core masses before the step, for crossing-safe criteria */
@@ -460,7 +469,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     if (n_divided) {
       since_division = 0;
       sum->divisions += n_divided;
-      dt = tc->dt; /* algorithm 2 now sets the pace */
+      dt = dt_max; /* algorithm 2 now sets the pace */
     }
     if (run->scene->source.rate > 0) {
       double *mass = malloc(sizeof(double) * (size_t)run->layout->n_cells);

@@ -90,6 +90,43 @@ int main(int argc, char **argv) {
         "%d failed attempts, %d reported on stderr, %d in energy.csv", sum.failed_attempts,
         reported, logged);
   sp_scene_destroy(&scene);
+
+  /* time.failure_memory = 6: after the failure at dt_f, dt climbs back to
+   * dt_f / grow and stays there for 6 accepted steps, then grows again */
+  const char *mem[] = {"division.n_div=0", "division.m=0", "solver.newton_max_its=4",
+                       "time.failure_memory=6", "time.t_end=0.0054"};
+  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 5, mem, &scene));
+  fflush(stderr);
+  const int saved2 = dup(fileno(stderr));
+  CHECK(freopen("hard_memory_stderr.txt", "w", stderr) != NULL, "cannot redirect stderr");
+  CHECK_OK(sp_stepper_run(scene, "hard_memory", MPI_COMM_WORLD, &sum));
+  fflush(stderr);
+  dup2(saved2, fileno(stderr));
+  close(saved2);
+  CHECK(csv_read("hard_memory/energy.csv", &e) == 0, "hard_memory/energy.csv unreadable");
+  int first = -1;
+  for (int i = 0; i < e.n_rows && first < 0; ++i)
+    if (at(&e, i, "failed_attempts") > 0) first = i;
+  CHECK(first > 0 && sum.failed_attempts == 1, "failure memory run: %d failed attempts",
+        sum.failed_attempts);
+  if (first > 0) {
+    const double dt_f = at(&e, first, "dt") / scene->time.shrink;
+    const double ceiling = dt_f / scene->time.grow;
+    double largest_in = 0, largest_after = 0;
+    for (int i = first; i < e.n_rows; ++i) {
+      const double dt = at(&e, i, "dt");
+      if (i < first + 6) largest_in = fmax(largest_in, dt);
+      else if (i < e.n_rows - 1) largest_after = fmax(largest_after, dt); /* not the last: t_end */
+    }
+    printf("failure memory: failed at dt %.3g; largest dt in the 6 steps after %.3g (ceiling "
+           "%.3g), then %.3g; t = %.6g\n", dt_f, largest_in, ceiling, largest_after, sum.t_final);
+    CHECK(largest_in <= ceiling * (1 + 1e-12) && largest_in >= ceiling * (1 - 1e-12),
+          "dt in the memory window %.17g, ceiling %.17g", largest_in, ceiling);
+    CHECK(largest_after > ceiling * 1.5, "dt did not grow after the memory: %g", largest_after);
+  }
+  CHECK(fabs(sum.t_final - 0.0054) < 1e-12, "the run ended at t = %.17g", sum.t_final);
+  free(e.v);
+  sp_scene_destroy(&scene);
   MPI_Finalize();
   TEST_DONE();
 }
