@@ -411,14 +411,16 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
         dt_ceiling = fmax(dt, dt_try / tc->grow);
         ceiling_steps = tc->failure_memory;
       }
+      const int give_up = failures > tc->max_retries || dt < tc->dt_min;
       if (run->rank == 0) { /* what failed, and the retry: no silent retries */
         fprintf(stderr, "softpack: step %d at t = %.6g, dt = %.3g: %s; |F|:", step + 1, t,
                 dt_try, report.reason);
         for (int i = 0; i < report.n_residuals; ++i)
           fprintf(stderr, " %.2e", report.residual_norms[i]);
-        fprintf(stderr, "; retried with dt = %.3g\n", dt);
+        if (give_up) fprintf(stderr, "; no retry\n");
+        else fprintf(stderr, "; retried with dt = %.3g\n", dt);
       }
-      if (failures > tc->max_retries || dt < tc->dt_min) {
+      if (give_up) {
         int rc_out = write_snapshot(run, step, t);
         rc = sp_error_set(SP_ERR_SOLVER,
                           "step %d at t = %.6g failed %d attempts "
