@@ -7,7 +7,9 @@
 #   runs: constant_volume_16 growth_12 embryo_8 growth_shape_12 (issue 4's run 4;
 #   with run 2 it prints the comparison of the two), and on request
 #   growth_shape_strong_12 and growth_shape_implicit_12 (run 4 with stronger
-#   penalties, the latter with the implicit term; added to the comparison)
+#   penalties, the latter with the implicit term; added to the comparison),
+#   growth_calibrated_12 and growth_shape_calibrated_12 (runs 2 and 4 on the
+#   seed calibrated for the paper's moduli: docs/paper-runs.md)
 # --reuse: do not rerun a run whose out/paper/<run>/ and out/paper/<run>.log
 # exist (tables and pictures from that earlier run).
 set -euo pipefail
@@ -73,7 +75,8 @@ if [ -f out/paper/growth_12/cells.csv ] && [ -f out/paper/growth_shape_12/cells.
   # (also out/paper/growth_shape_12_implicit and growth_shape_implicit_2e5
   # when present: the commands are in docs/paper-runs.md)
   for run in growth_12 growth_shape_12 growth_shape_strong_12 growth_shape_implicit_12 \
-             growth_shape_12_implicit growth_shape_implicit_2e5; do
+             growth_shape_12_implicit growth_shape_implicit_2e5 \
+             growth_calibrated_12 growth_shape_calibrated_12; do
     out=out/paper/$run
     [ -f "$out/cells.csv" ] || continue
     e=$(awk -F, 'NR > 1 { last = $6; shape = $11; if ($6 > peak) peak = $6 } END { printf "%.4g (%.3g) | %.4g", last, shape, peak }' "$out/energy.csv")
