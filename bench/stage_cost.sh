@@ -4,9 +4,10 @@
 # their centres, on SCENE's mesh and model, without division or source, for
 # STEPS steps of dt: seconds per step and per Newton iteration, its phases,
 # unknowns and peak memory, full against local in one run of the script.
-# A whole run with full supports at 16 cells is beyond this machine (the
-# paper's run 1 would need hours of factorisations); this measures the
-# 16-cell stage the same way for both layouts.
+# A whole run 1 with full supports takes about an hour here (53 minutes,
+# docs/local-support.md: bench/local_support.sh on run 1); this measures
+# one stage, e.g. the 16-cell one, the same way for both layouts in
+# minutes.
 #   bench/stage_cost.sh [RUN_DIR] [SCENE] [STEPS] [DT] [STEP]
 #   (defaults: out/paper/constant_volume_16 inputs/paper/constant_volume_16.yaml 3 2e-5, last step)
 set -euo pipefail
