@@ -104,21 +104,18 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   StepInterface &i_;
 };
 
-// Records ||F|| at the start and after every iteration.
+// Records ||F|| at the start and after every iteration (Solver::note_residual).
 class ResidualRecorder : public NOX::Observer {
  public:
-  ResidualRecorder(Solver &s, sp_step_report &r) : s_(s), r_(r) {}
+  explicit ResidualRecorder(Solver &s) : s_(s) {}
   void runPreSolve(const NOX::Solver::Generic &solver) override { record(solver); }
   void runPostIterate(const NOX::Solver::Generic &solver) override { record(solver); }
 
  private:
   void record(const NOX::Solver::Generic &solver) {
-    const double norm = solver.getSolutionGroup().getNormF();
-    s_.note_residual(norm);
-    if (r_.n_residuals < SP_MAX_NEWTON_HISTORY) r_.residual_norms[r_.n_residuals++] = norm;
+    s_.note_residual(solver.getSolutionGroup().getNormF());
   }
   Solver &s_;
-  sp_step_report &r_;
 };
 
 // Converged only after at least one Newton update: the update conserves
@@ -558,7 +555,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   params->sublist("Printing").set("Output Information", 0);
   params->sublist("Solver Options").set("Status Test Check Type", "Complete");
   params->sublist("Solver Options").set<Teuchos::RCP<NOX::Observer>>(
-      "User Defined Pre/Post Operator", Teuchos::rcp(new ResidualRecorder(*this, report)));
+      "User Defined Pre/Post Operator", Teuchos::rcp(new ResidualRecorder(*this)));
   NOX::Epetra::Vector guess(x0, NOX::DeepCopy);
   auto group = Teuchos::rcp(new NOX::Epetra::Group(params->sublist("Printing"), iface, guess, linsys));
 
@@ -588,6 +585,8 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   StatusType status = solver->solve();
   report.newton_its = solver->getNumIterations();
   report.factorisations = step_factorisations_;
+  report.n_residuals = (int)std::min<size_t>(step_norms_.size(), SP_MAX_NEWTON_HISTORY);
+  std::copy(step_norms_.begin(), step_norms_.begin() + report.n_residuals, report.residual_norms);
   report.t_assembly = t_assembly;
   report.t_factor = t_factor;
   report.t_solve = t_solve;
