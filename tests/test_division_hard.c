@@ -39,6 +39,19 @@ static int count_rows(const char *path, int *same_step) {
   return rows;
 }
 
+/* Runs @p scene into @p out with stderr going to @p err_path (every failed
+ * attempt is reported there). */
+static void run_capturing_stderr(const sp_scene *scene, const char *out, const char *err_path,
+                                 sp_run_summary *sum) {
+  fflush(stderr);
+  const int saved = dup(fileno(stderr));
+  CHECK(freopen(err_path, "w", stderr) != NULL, "cannot redirect stderr to %s", err_path);
+  CHECK_OK(sp_stepper_run(scene, out, MPI_COMM_WORLD, sum));
+  fflush(stderr);
+  dup2(saved, fileno(stderr));
+  close(saved);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   sp_scene *scene;
@@ -58,14 +71,7 @@ int main(int argc, char **argv) {
   const char *set[] = {"division.n_div=0", "division.m=0", "solver.newton_max_its=4"};
   CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 3, set, &scene));
   scene->time.t_end = 0.0046; /* the first division and a few steps */
-  /* stderr to a file: every failed attempt is reported there */
-  fflush(stderr);
-  const int saved = dup(fileno(stderr));
-  CHECK(freopen("hard_retry_stderr.txt", "w", stderr) != NULL, "cannot redirect stderr");
-  CHECK_OK(sp_stepper_run(scene, "hard_retry", MPI_COMM_WORLD, &sum));
-  fflush(stderr);
-  dup2(saved, fileno(stderr));
-  close(saved);
+  run_capturing_stderr(scene, "hard_retry", "hard_retry_stderr.txt", &sum);
   printf("no algorithm 2: %d cells, %d failed attempts retried, smallest dt %.3g\n", sum.n_cells,
          sum.failed_attempts, sum.dt_smallest);
   CHECK(sum.n_cells == 2, "%d cells", sum.n_cells);
@@ -96,13 +102,7 @@ int main(int argc, char **argv) {
   const char *mem[] = {"division.n_div=0", "division.m=0", "solver.newton_max_its=4",
                        "time.failure_memory=6", "time.t_end=0.0054"};
   CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 5, mem, &scene));
-  fflush(stderr);
-  const int saved2 = dup(fileno(stderr));
-  CHECK(freopen("hard_memory_stderr.txt", "w", stderr) != NULL, "cannot redirect stderr");
-  CHECK_OK(sp_stepper_run(scene, "hard_memory", MPI_COMM_WORLD, &sum));
-  fflush(stderr);
-  dup2(saved2, fileno(stderr));
-  close(saved2);
+  run_capturing_stderr(scene, "hard_memory", "hard_memory_stderr.txt", &sum);
   CHECK(csv_read("hard_memory/energy.csv", &e) == 0, "hard_memory/energy.csv unreadable");
   int first = -1;
   for (int i = 0; i < e.n_rows && first < 0; ++i)
