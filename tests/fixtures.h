@@ -66,6 +66,17 @@ static inline void set_disk(const sp_mesh *mesh, const sp_layout *layout, double
   }
 }
 
+/** Three touching cells on the unit square (width d = sqrt(kappa / 2 alpha)
+ *  of the paper's parameters): the typical step of test_newton and
+ *  test_jacobian_reuse. */
+static inline void set_three_touching_disks(const sp_mesh *mesh, const sp_layout *layout,
+                                            double *state) {
+  const double d = sqrt(1e-3 / 8);
+  set_disk(mesh, layout, state, 0, 0.35, 0.5, 0.15, d);
+  set_disk(mesh, layout, state, 1, 0.65, 0.5, 0.15, d);
+  set_disk(mesh, layout, state, 2, 0.5, 0.75, 0.11, d);
+}
+
 /** c_k = 1 / (1 + exp((rho - 1) / eps)), rho = sqrt((u/a)^2 + (v/b)^2),
  *  (u, v) the coordinates along the ellipse's axes (the a axis at angle
  *  phi), centred at (x, y), no background; mu_k = 0. */

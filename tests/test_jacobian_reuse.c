@@ -30,10 +30,7 @@ int main(int argc, char **argv) {
   const int n = 2 * layout->n_pairs;
   double *a = calloc(n, sizeof(double)), *b = calloc(n, sizeof(double));
   double *old = calloc(n, sizeof(double));
-  const double d = sqrt(1e-3 / 8);
-  set_disk(mesh, layout, a, 0, 0.35, 0.5, 0.15, d);
-  set_disk(mesh, layout, a, 1, 0.65, 0.5, 0.15, d);
-  set_disk(mesh, layout, a, 2, 0.5, 0.75, 0.11, d);
+  set_three_touching_disks(mesh, layout, a);
   for (int i = 0; i < n; ++i) b[i] = a[i];
   sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
   int its_newton = 0, its = 0, factorisations = 0;

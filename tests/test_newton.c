@@ -13,10 +13,7 @@ int main(int argc, char **argv) {
   sp_solver s = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
   const int n = 2 * layout->n_pairs;
   double *state = calloc(n, sizeof(double)), *old = calloc(n, sizeof(double));
-  const double d = sqrt(1e-3 / 8);
-  set_disk(mesh, layout, state, 0, 0.35, 0.5, 0.15, d);
-  set_disk(mesh, layout, state, 1, 0.65, 0.5, 0.15, d);
-  set_disk(mesh, layout, state, 2, 0.5, 0.75, 0.11, d);
+  set_three_touching_disks(mesh, layout, state);
   sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
   /* A first step to get off the initial state (mu = 0), then the typical one. */
   sp_step_report rep;
