@@ -45,6 +45,32 @@ typedef struct {
   double dt;
 } relax_setup;
 
+/** One cell on a 64 x 64 mesh of [0, 0.5]^2 (full layout): the state (zero)
+ *  and a c^n buffer of the same size. */
+typedef struct {
+  sp_mesh *mesh;
+  sp_layout *layout;
+  size_t n_values;
+  double *state, *old;
+} one_cell;
+
+static inline one_cell one_cell_create(void) {
+  one_cell o;
+  CHECK_OK(sp_mesh_rectangle(0, 0, 0.5, 0.5, 64, 64, &o.mesh));
+  CHECK_OK(sp_layout_create_full(o.mesh->n_nodes, 1, &o.layout));
+  o.n_values = 2 * (size_t)o.layout->n_pairs;
+  o.state = calloc(o.n_values, sizeof(double));
+  o.old = malloc(o.n_values * sizeof(double));
+  return o;
+}
+
+static inline void one_cell_destroy(one_cell *o) {
+  free(o->state);
+  free(o->old);
+  sp_layout_destroy(&o->layout);
+  sp_mesh_destroy(&o->mesh);
+}
+
 typedef struct {
   int ok;                  /**< every step converged */
   int steps_done, newton_its;
@@ -59,12 +85,11 @@ typedef struct {
  *  of each c^n (shape term off when delta2 = 0); stops at a failed step. */
 static inline relax_result relax_ellipse(relax_setup r) {
   relax_result out = {.ok = 1};
-  sp_mesh *mesh;
-  sp_layout *layout;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 0.5, 0.5, 64, 64, &mesh));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
-  const size_t n_values = 2 * (size_t)layout->n_pairs;
-  double *state = calloc(n_values, sizeof(double)), *old = malloc(n_values * sizeof(double));
+  one_cell o = one_cell_create();
+  const sp_mesh *mesh = o.mesh;
+  const sp_layout *layout = o.layout;
+  const size_t n_values = o.n_values;
+  double *state = o.state, *old = o.old;
   const sp_model_params model = paper_model();
   const double d = sqrt(model.kappa / (2 * model.alpha));
   /* eps in rho units: the width d across the minor axis */
@@ -105,11 +130,8 @@ static inline relax_result relax_ellipse(relax_setup r) {
   }
   out.energy_end = energy;
   out.i2_end = obs.I2;
-  free(state);
-  free(old);
   sp_solver_destroy(&solver);
-  sp_layout_destroy(&layout);
-  sp_mesh_destroy(&mesh);
+  one_cell_destroy(&o);
   return out;
 }
 #endif

@@ -279,12 +279,11 @@ static void test_round(void) {
 
   /* a symmetric round tanh disk (I1 = I2 to round-off) with Iref pulling
    * the moments apart: a few solver steps stay finite */
-  sp_mesh *mesh;
-  sp_layout *layout;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 0.5, 0.5, 64, 64, &mesh));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
-  const size_t n_values = 2 * (size_t)layout->n_pairs;
-  double *state = calloc(n_values, sizeof(double)), *old = malloc(n_values * sizeof(double));
+  one_cell o = one_cell_create();
+  const sp_mesh *mesh = o.mesh;
+  const sp_layout *layout = o.layout;
+  const size_t n_values = o.n_values;
+  double *state = o.state, *old = o.old;
   const sp_model_params model = paper_model();
   set_disk(mesh, layout, state, 0, 0.25, 0.25, 0.1, sqrt(model.kappa / (2 * model.alpha)));
   sp_cell_obs obs;
@@ -320,11 +319,8 @@ static void test_round(void) {
   CHECK(finite, "non-finite values in the round-disk steps");
   CHECK(e_max <= 1.05 * e0, "round disk: energy grew from %.6g to %.6g", e0, e_max);
   CHECK(obs.I1 / obs.I2 < 1.01, "round disk: became elongated (I1/I2 = %.4f)", obs.I1 / obs.I2);
-  free(state);
-  free(old);
   sp_solver_destroy(&solver);
-  sp_layout_destroy(&layout);
-  sp_mesh_destroy(&mesh);
+  one_cell_destroy(&o);
 }
 
 /** K steps of a slightly elongated cell on a background, with (delta2 > 0)
