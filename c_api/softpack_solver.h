@@ -53,6 +53,10 @@ typedef struct {
    *  much (||F_k|| <= jacobian_reuse ||F_k-1||); the first iteration of a
    *  step always has a fresh one. 0: a new Jacobian every iteration. */
   double jacobian_reuse;
+  /** A step fails as soon as an iteration's ||F_k|| exceeds this multiple
+   *  of the step's first ||F_0|| (it is retried with a smaller dt without
+   *  spending the rest of newton_max_its). 0: off; otherwise > 1. */
+  double newton_divergence;
 } sp_solver_options;
 
 /** The mesh, borrowed (must outlive the solver's use of it). */

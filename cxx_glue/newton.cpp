@@ -164,6 +164,36 @@ class FactorisationLimit : public NOX::StatusTest::Generic {
   NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unevaluated;
 };
 
+// Fails a step as soon as ||F_k|| > ratio ||F_0|| (sp_solver_options.
+// newton_divergence): the failed attempts of a packed aggregate all blow
+// up within a few iterations, and the retry with a smaller dt comes the
+// same whether the step fails now or after newton_max_its iterations.
+class RelativeDivergence : public NOX::StatusTest::Generic {
+ public:
+  RelativeDivergence(const Solver &s, double ratio) : s_(s), ratio_(ratio) {}
+  NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic &solver,
+                                          NOX::StatusTest::CheckType) override {
+    // ||F_0|| was recorded before the first iteration (ResidualRecorder).
+    const double first = s_.step_first_norm();
+    status_ = solver.getNumIterations() >= 1 &&
+                      solver.getSolutionGroup().getNormF() > ratio_ * first
+                  ? NOX::StatusTest::Failed
+                  : NOX::StatusTest::Unconverged;
+    return status_;
+  }
+  NOX::StatusTest::StatusType getStatus() const override { return status_; }
+  std::ostream &print(std::ostream &s, int indent) const override {
+    for (int i = 0; i < indent; ++i) s << ' ';
+    s << status_ << "||F|| <= " << ratio_ << " ||F_0||\n";
+    return s;
+  }
+
+ private:
+  const Solver &s_;
+  double ratio_;
+  NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unevaluated;
+};
+
 }  // namespace
 
 Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
@@ -172,6 +202,8 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     throw std::runtime_error("solver.jacobian: unknown kind");
   if (!(options.jacobian_reuse >= 0 && options.jacobian_reuse < 1))
     throw std::runtime_error("solver.jacobian_reuse: expected 0 <= value < 1");
+  if (!(options.newton_divergence == 0 || options.newton_divergence > 1))
+    throw std::runtime_error("solver.newton_divergence: expected 0 (off) or a value > 1");
   const int P = comm_.NumProc();
   switch (options.linear) {
     case SP_SOLVER_SUPERLU:
@@ -577,6 +609,11 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
     all->addStatusTest(Teuchos::rcp(new FactorisationLimit(*this, options_.newton_max_its)));
   all->addStatusTest(Teuchos::rcp(new MaxIters(max_its)));
   all->addStatusTest(Teuchos::rcp(new Divergence(1e30)));
+  Teuchos::RCP<RelativeDivergence> diverged;
+  if (options_.newton_divergence > 0) {
+    diverged = Teuchos::rcp(new RelativeDivergence(*this, options_.newton_divergence));
+    all->addStatusTest(diverged);
+  }
   // The relative test evaluated F at the guess: that fill is not a Newton
   // iteration's work but is counted in assembly all the same.
 
@@ -600,8 +637,15 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
     return 0;
   }
   const double last = report.n_residuals ? report.residual_norms[report.n_residuals - 1] : NAN;
+  char ratio[32];
+  snprintf(ratio, sizeof ratio, "%g", options_.newton_divergence);
   std::string why = !last_error.empty() ? last_error
                     : !std::isfinite(last) ? "the residual is not finite"
+                    : !diverged.is_null() && diverged->getStatus() == Failed
+                        ? "diverged: |F| above " + std::string(ratio) +
+                              " x the first |F| after " + std::to_string(report.newton_its) +
+                              " Newton iterations (" + std::to_string(report.factorisations) +
+                              " factorisations)"
                     : report.newton_its >= max_its ||
                               report.factorisations >= options_.newton_max_its
                         ? "no convergence in " + std::to_string(report.newton_its) +

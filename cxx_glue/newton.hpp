@@ -49,6 +49,8 @@ class Solver {
   // iteration may keep the factorisation of this step's last Jacobian.
   bool may_reuse_jacobian() const;
   int step_factorisations() const { return step_factorisations_; }
+  // ||F|| at the current step's guess (NaN before it is recorded).
+  double step_first_norm() const { return step_norms_.empty() ? NAN : step_norms_.front(); }
 
   std::string last_error;
   Teuchos::RCP<Epetra_FECrsMatrix> jacobian_matrix;

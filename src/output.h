@@ -27,19 +27,23 @@ int sp_output_open(const char *dir, sp_output *out);
  *  unknowns of the Newton system the step solved (2 x the (cell, node)
  *  pairs of the layout before any support change after it), the
  *  factorisations of the accepted attempt (fewer than its Newton
- *  iterations with solver.jacobian_reuse) and the failed attempts before
- *  it. */
+ *  iterations with solver.jacobian_reuse), the failed attempts before
+ *  it and their factorisations, and the largest rise of the residual norm
+ *  over its first in the accepted attempt (below 1: |F| never rose; what
+ *  solver.newton_divergence must stay above). */
 typedef struct {
   double step, assembly, factorisation, solves, supports;
   int support_changed;
   long unknowns;
-  int factorisations, failed_attempts;
+  int factorisations, failed_attempts, failed_factorisations;
+  double residual_rise; /**< largest ||F_k|| / ||F_0|| of the accepted attempt */
 } sp_step_costs;
 
 /** @brief Append one row to energy.csv:
  *  step,t,dt,newton_its,n_cells,energy,bulk,gradient,repulsion,buffer,shape,
  *  seconds,assembly_s,factorisation_s,solves_s,supports_s,support_changed,
- *  unknowns,factorisations,failed_attempts
+ *  unknowns,factorisations,failed_attempts,failed_factorisations,
+ *  residual_rise
  *  (@p seconds NULL: zeros) */
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,

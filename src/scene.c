@@ -290,6 +290,11 @@ static const sp_key sp_keys[] = {
               "modified Newton: an iteration keeps the last Jacobian and its "
               "factorisation while the previous one cut the residual norm by "
               "at least this factor (0: a new Jacobian every iteration)"),
+    KEY_FLOAT(SP_SEC_SOLVER, "newton_divergence", solver.newton_divergence, 0.0,
+              AT_LEAST(0.0), UNBOUNDED, "-",
+              "a step fails (and is retried with a smaller dt) as soon as an "
+              "iteration's residual norm exceeds this multiple of the step's "
+              "first one (0: off; otherwise > 1)"),
     /* output */
     KEY_INT(SP_SEC_OUTPUT, "every", output.every, 10, AT_LEAST(1),
             AT_MOST(INT_MAX), "steps",
@@ -1059,6 +1064,10 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
            "%s: time.dt_min: expected a number <= time.dt = %.15g, got "
            "%.15g",
            file, t->dt, t->dt_min);
+  SP_CHECK(scene->solver.newton_divergence == 0 || scene->solver.newton_divergence > 1,
+           SP_ERR_INPUT,
+           "%s: solver.newton_divergence: expected 0 (off) or a number > 1, got %.15g",
+           file, scene->solver.newton_divergence);
   SP_CHECK(scene->layout.band < scene->layout.margin, SP_ERR_INPUT,
            "%s: layout.band: expected a number < layout.margin = %.15g, got "
            "%.15g",

@@ -82,6 +82,8 @@ typedef struct {
   int newton_max_its;  /**< iterations before a step counts as failed */
   double jacobian_reuse; /**< modified Newton: keep the factorisation while
                               each iteration cuts ||F|| by this (0: never) */
+  double newton_divergence; /**< fail a step once ||F_k|| > this x ||F_0||
+                                 (0: off) */
 } sp_scene_solver;
 
 /** output: what is written and when. */

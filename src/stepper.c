@@ -35,6 +35,7 @@ void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt)
   opt->newton_atol = scene->solver.newton_atol;
   opt->newton_max_its = scene->solver.newton_max_its;
   opt->jacobian_reuse = scene->solver.jacobian_reuse;
+  opt->newton_divergence = scene->solver.newton_divergence;
 }
 
 void sp_model_from_scene(const sp_scene *scene, sp_model_params *model) {
@@ -405,6 +406,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       ++failures;
       ++seconds.failed_attempts;
       ++sum->failed_attempts;
+      seconds.failed_factorisations += report.factorisations;
+      sum->failed_factorisations += report.factorisations;
       successes = 0;
       dt = dt_try * tc->shrink;
       if (tc->failure_memory > 0) {
@@ -439,6 +442,10 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     sum->newton_its += report.newton_its;
     sum->factorisations += report.factorisations;
     seconds.factorisations = report.factorisations;
+    seconds.residual_rise = 0;
+    for (int i = 1; i < report.n_residuals; ++i)
+      seconds.residual_rise =
+          fmax(seconds.residual_rise, report.residual_norms[i] / report.residual_norms[0]);
     sum->t_final = t;
     if (since_division >= 0) ++since_division;
     if (dt_try < sum->dt_smallest) sum->dt_smallest = dt_try;

@@ -25,6 +25,7 @@ typedef struct {
   int failed_attempts; /**< Newton failures that were retried */
   long newton_its;     /**< Newton iterations of accepted steps */
   long factorisations; /**< their factorisations (solver.jacobian_reuse) */
+  long failed_factorisations; /**< factorisations of the failed attempts */
   double t_final;      /**< time reached */
   double dt_smallest;  /**< smallest accepted dt */
   double wall_seconds;

@@ -6,7 +6,9 @@
  *   (n_div = 0, m = 0) the first step after a sharp cut is taken at the
  *   full dt and needs 5 Newton iterations where a steady step needs 2;
  *   with solver.newton_max_its = 4 it fails, is retried with a smaller dt
- *   and the run goes on (never accepting the failed step). */
+ *   and the run goes on (never accepting the failed step);
+ * - solver.newton_divergence: attempts that blow up stop as soon as |F|
+ *   passes the ratio, the run is otherwise the same. */
 #include <string.h>
 #include <unistd.h>
 
@@ -50,6 +52,102 @@ static void run_capturing_stderr(const sp_scene *scene, const char *out, const c
   fflush(stderr);
   dup2(saved, fileno(stderr));
   close(saved);
+}
+
+/* The |F| histories of the failed attempts reported in @p err_path (the
+ * text after "|F|: " up to ";"), at most @p max; returns their number. */
+static int failed_histories(const char *err_path, char hist[][1024], int max) {
+  int n = 0;
+  FILE *f = fopen(err_path, "r");
+  char line[2048];
+  while (f && n < max && fgets(line, sizeof line, f)) {
+    const char *h = strstr(line, "|F|: ");
+    if (!h) continue;
+    h += strlen("|F|: ");
+    const size_t len = strcspn(h, ";");
+    CHECK(len < 1024, "history too long: %s", line);
+    memcpy(hist[n], h, len);
+    hist[n++][len] = 0;
+  }
+  if (f) fclose(f);
+  return n;
+}
+
+/* Runs divide_1_2_4 without algorithm 2 at dt = 4e-3 with the given
+ * newton_divergence ("0": off); Newton blows up after the cut. */
+static void run_divergent(const char *ratio, const char *out, const char *err,
+                          sp_run_summary *sum) {
+  char set_ratio[64];
+  snprintf(set_ratio, sizeof set_ratio, "solver.newton_divergence=%s", ratio);
+  const char *set[] = {"division.n_div=0", "division.m=0", "time.dt=4e-3", "time.t_end=0.006",
+                       "output.pictures=false", set_ratio};
+  sp_scene *scene;
+  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 6, set, &scene));
+  run_capturing_stderr(scene, out, err, sum);
+  sp_scene_destroy(&scene);
+}
+
+/* solver.newton_divergence = 100 against off on a run whose attempts after
+ * the cut blow up: each failed attempt stops at the first |F| above 100 x
+ * its first (its history is a prefix of the unchecked one), the retries
+ * and the accepted states are the same, and the factorisations saved are
+ * exactly the iterations cut off. */
+static void check_divergence_ratio(void) {
+  sp_run_summary off, on;
+  run_divergent("0", "hard_div_off", "hard_div_off_stderr.txt", &off);
+  run_divergent("100", "hard_div_on", "hard_div_on_stderr.txt", &on);
+  char h_off[8][1024], h_on[8][1024];
+  const int n_off = failed_histories("hard_div_off_stderr.txt", h_off, 8),
+            n_on = failed_histories("hard_div_on_stderr.txt", h_on, 8);
+  printf("divergence ratio 100: %d failed attempts (%ld factorisations) against %d (%ld) "
+         "unchecked\n", on.failed_attempts, on.failed_factorisations, off.failed_attempts,
+         off.failed_factorisations);
+  CHECK(off.failed_attempts >= 1 && n_off == off.failed_attempts && n_on == on.failed_attempts &&
+            on.failed_attempts == off.failed_attempts && on.steps == off.steps,
+        "failed attempts %d/%d reported %d/%d, steps %d/%d", on.failed_attempts,
+        off.failed_attempts, n_on, n_off, on.steps, off.steps);
+  long cut = 0;
+  for (int a = 0; a < n_on; ++a) {
+    double v[32];
+    int n = 0;
+    for (char *p = h_on[a], *end; n < 32; p = end) {
+      v[n] = strtod(p, &end);
+      if (end == p) break;
+      ++n;
+    }
+    printf("  attempt %d: %s\n     unchecked: %s\n", a, h_on[a], h_off[a]);
+    CHECK(n >= 2 && v[n - 1] > 100 * v[0], "attempt %d did not end above 100 |F_0|", a);
+    for (int k = 1; k < n - 1; ++k)
+      CHECK(v[k] <= 100 * v[0], "attempt %d went on past |F_%d| = %g", a, k, v[k]);
+    CHECK(strncmp(h_on[a], h_off[a], strlen(h_on[a])) == 0,
+          "attempt %d is not the start of the unchecked one", a);
+    int n_unchecked = 1;
+    for (const char *p = h_off[a]; (p = strchr(p, ' ')); ++p) ++n_unchecked;
+    cut += n_unchecked - n;
+  }
+  CHECK(on.factorisations == off.factorisations &&
+            on.failed_factorisations == off.failed_factorisations - cut,
+        "%ld + %ld factorisations, expected %ld + (%ld - %ld)", on.factorisations,
+        on.failed_factorisations, off.factorisations, off.failed_factorisations, cut);
+  csv_table a, b;
+  CHECK(csv_read("hard_div_off/energy.csv", &a) == 0 && csv_read("hard_div_on/energy.csv", &b) == 0,
+        "energy.csv unreadable");
+  CHECK(a.n_rows == b.n_rows, "%d rows against %d", b.n_rows, a.n_rows);
+  for (int i = 0; i < a.n_rows && i < b.n_rows; ++i)
+    CHECK(at(&a, i, "t") == at(&b, i, "t") &&
+              at(&a, i, "residual_rise") == at(&b, i, "residual_rise") &&
+              fabs(at(&a, i, "energy") - at(&b, i, "energy")) <= 1e-13 * fabs(at(&a, i, "energy")),
+          "row %d: t %.17g / %.17g, energy %.17g / %.17g, |F| rise %g / %g", i, at(&b, i, "t"),
+          at(&a, i, "t"), at(&b, i, "energy"), at(&a, i, "energy"), at(&b, i, "residual_rise"),
+          at(&a, i, "residual_rise"));
+  free(a.v);
+  free(b.v);
+  FILE *f = fopen("hard_div_on_stderr.txt", "r");
+  char line[2048];
+  int named = 0;
+  while (f && fgets(line, sizeof line, f)) named += strstr(line, "diverged: |F| above 100 x") != NULL;
+  if (f) fclose(f);
+  CHECK(named == on.failed_attempts, "%d of %d failures say why", named, on.failed_attempts);
 }
 
 int main(int argc, char **argv) {
@@ -127,6 +225,8 @@ int main(int argc, char **argv) {
   CHECK(fabs(sum.t_final - 0.0054) < 1e-12, "the run ended at t = %.17g", sum.t_final);
   free(e.v);
   sp_scene_destroy(&scene);
+
+  check_divergence_ratio();
   MPI_Finalize();
   TEST_DONE();
 }

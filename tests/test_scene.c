@@ -205,6 +205,7 @@ static void test_overrides(void) {
       {"noise.seed=-1", "noise.seed"},         /* negative unsigned */
       {"cells.x=0", "cells.x"},                /* cells are file only */
       {"time.dt=1e-15", "time.dt_min"},        /* cross-key: dt_min > dt */
+      {"solver.newton_divergence=0.5", "solver.newton_divergence"}, /* 0 or > 1 */
       {"mesh.semi_y=0.1", "cells[1].radius"},  /* cells no longer fit */
   };
   for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i)
