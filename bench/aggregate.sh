@@ -68,5 +68,23 @@ awk -F, -v nodes="$nodes" 'NR == 1 { for (j = 1; j <= NF; ++j) c[$j] = j; next }
   "$out/energy.csv"
 echo
 echo "(steps with N cells include the ramp of algorithm 2 after each division: tiny steps of 2-3 iterations)"
+echo
+echo "The same per kind of step: the ramp of algorithm 2 (dt < 1e-5) and the others (regular):"
+echo
+echo "| cells | ramp steps | its/step | factorisations/step | s/step/cell | vs 16 | regular steps | its/step | factorisations/step | s/step/cell | vs 16 |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
+awk -F, 'NR == 1 { for (j = 1; j <= NF; ++j) c[$j] = j; next }
+  $1 > 0 { n = $c["n_cells"]; if (!(n in seen)) { seen[n] = 1; order[++k] = n }
+    r = $c["dt"] < 1e-5 ? 1 : 2; steps[n, r]++; its[n, r] += $c["newton_its"]; sec[n, r] += $c["seconds"]
+    if ("failed_factorisations" in c) fa[n, r] += $c["factorisations"] + $c["failed_factorisations"] }
+  function cell(n, r, ref) {
+    if (!steps[n, r]) return "0 | - | - | - | -"
+    return sprintf("%d | %.2f | %s | %.4f | %s", steps[n, r], its[n, r] / steps[n, r],
+                   ("failed_factorisations" in c) ? sprintf("%.2f", fa[n, r] / steps[n, r]) : "-",
+                   sec[n, r] / steps[n, r] / n, ref ? sprintf("%.2f", sec[n, r] / steps[n, r] / n / ref) : "-") }
+  END { for (r = 1; r <= 2; ++r) ref[r] = steps[16, r] ? sec[16, r] / steps[16, r] / 16 : 0
+    for (i = 1; i <= k; ++i) { n = order[i]; printf "| %d | %s | %s |\n", n, cell(n, 1, ref[1]), cell(n, 2, ref[2]) } }' \
+  "$out/energy.csv"
+echo "(factorisations/step: of the accepted attempt and the failed ones before it)"
 stage_pictures "$out" "$img" 3 16 64 128 256
 echo "pictures: $(ls "$img" | tr '\n' ' ')"
