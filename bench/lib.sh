@@ -52,3 +52,31 @@ compare_runs() {
   cut -d, -f1-5 "$a/divisions.csv" | sed 's/^/  /'
   cut -d, -f1-5 "$b/divisions.csv" | sed 's/^/  /'
 }
+
+# ab_runs SCENE NAME_A SET_A NAME_B SET_B [--set k=v ...]: the scene run
+# twice in one go, with --set SET_A (the baseline) and with --set SET_B,
+# each with its wall time, peak memory, phases, Newton iterations,
+# factorisations and failed attempts, then the agreement of the two runs
+# (compare_runs). Honours NP (mpirun with NP processes), SOFTPACK (another
+# binary) and OUT (keeps OUT/NAME_A and OUT/NAME_B).
+ab_runs() {
+  local scene=$1 names=("$2" "$4") sets=("$3" "$5") i run
+  shift 5
+  local bin=${SOFTPACK:-build/softpack} out=${OUT:-$(mktemp -d)} launch=()
+  [ "${NP:-1}" -gt 1 ] && launch=(mpirun --allow-run-as-root -np "$NP")
+  export OMP_NUM_THREADS=1
+  for i in 0 1; do
+    run=${names[$i]}
+    /usr/bin/time -f "$run: %e s wall, %M kB peak (rank 0)" "${launch[@]}" "$bin" run "$scene" \
+        --out "$out/$run" --set "${sets[$i]}" --set output.pictures=false "$@" 2>&1 |
+      grep -v "^softpack: step\|^  " | sed "s/^/$run: /"
+  done
+  echo "per accepted step (energy.csv): Newton iterations, factorisations, failed attempts, seconds"
+  for run in "${names[@]}"; do
+    awk -F, -v run="$run" 'NR > 1 && $1 > 0 { s++; it += $4; f += $19; fa += $20; sec += $12; fs += $14 }
+      END { printf "  %s: %d steps, %.2f iterations/step, %.2f factorisations/step, %d failed attempts, %.3f s/step (factorisation %.3f)\n",
+            run, s, it / s, f / s, fa, sec / s, fs / s }' "$out/$run/energy.csv"
+  done
+  compare_runs "$out/${names[0]}" "$out/${names[1]}"
+  [ -n "${OUT:-}" ] || rm -rf "$out"
+}

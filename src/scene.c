@@ -128,6 +128,8 @@ static const cyaml_strval_t sp_linear_words[] = {
     {"superlu_dist", SP_LINEAR_SUPERLU_DIST},
     {"mumps", SP_LINEAR_MUMPS},
     {"klu2", SP_LINEAR_KLU2}};
+static const cyaml_strval_t sp_predictor_words[] = {
+    {"none", SP_PREDICT_NONE}, {"linear", SP_PREDICT_LINEAR}};
 static const cyaml_strval_t sp_division_words[] = {
     {"none", SP_DIVIDE_NONE}, {"age", SP_DIVIDE_BY_AGE}, {"mass", SP_DIVIDE_BY_MASS}};
 static const cyaml_strval_t sp_cut_words[] = {
@@ -295,6 +297,11 @@ static const sp_key sp_keys[] = {
               "a step fails (and is retried with a smaller dt) as soon as an "
               "iteration's residual norm exceeds this multiple of the step's "
               "first one (0: off; otherwise > 1)"),
+    KEY_ENUM(SP_SEC_SOLVER, "predictor", solver.predictor, SP_PREDICT_NONE,
+             sp_predictor_words, "-",
+             "Newton's initial guess: the last state (none) or the last state "
+             "plus its last increment x min(dt / dt_last, 2) (linear; not "
+             "across a division)"),
     /* output */
     KEY_INT(SP_SEC_OUTPUT, "every", output.every, 10, AT_LEAST(1),
             AT_MOST(INT_MAX), "steps",

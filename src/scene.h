@@ -18,6 +18,8 @@ extern "C" {
 typedef enum { SP_MESH_RECTANGLE = 0, SP_MESH_ELLIPSE = 1 } sp_mesh_kind;
 typedef enum { SP_PROFILE_TANH = 0, SP_PROFILE_SHARP = 1 } sp_profile_kind;
 typedef enum { SP_JAC_AD = 0, SP_JAC_HAND = 1, SP_JAC_FD = 2 } sp_jacobian_kind;
+/** Newton's initial guess: the last state, or extrapolated from the last two. */
+typedef enum { SP_PREDICT_NONE = 0, SP_PREDICT_LINEAR = 1 } sp_predictor_kind;
 typedef enum {
   SP_LINEAR_SUPERLU = 0,
   SP_LINEAR_SUPERLU_DIST = 1,
@@ -84,6 +86,7 @@ typedef struct {
                               each iteration cuts ||F|| by this (0: never) */
   double newton_divergence; /**< fail a step once ||F_k|| > this x ||F_0||
                                  (0: off) */
+  sp_predictor_kind predictor; /**< Newton's initial guess */
 } sp_scene_solver;
 
 /** output: what is written and when. */

@@ -64,6 +64,9 @@ int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *lay
 
 /** layout.support: auto turns local supports on beyond this many cells. */
 #define SP_AUTO_LOCAL_CELLS 4
+/** solver.predictor linear: the last increment is scaled by dt / dt_last,
+ *  at most this much (algorithm 2's ramp multiplies dt by up to 64). */
+#define SP_PREDICTOR_MAX_RATIO 2.0
 
 static double wall_clock(void) {
   struct timespec ts;
@@ -80,6 +83,12 @@ typedef struct {
   sp_output output;
   sp_model_params model;
   double *state, *state_old;
+  /* solver.predictor linear: the state before the last accepted step (on
+   * the current layout) and that step's dt; valid from the second step on
+   * and not across a division */
+  double *state_prev;
+  double dt_prev;
+  int prev_valid;
   sp_cell_obs *obs;
   double *energy_t, *energy_total; /* the energy history for energy.png */
   int n_energy, cap_energy;
@@ -188,14 +197,18 @@ static int grow_array(void **ptr, size_t elem, int n_old, int n) {
 }
 
 /** Make (layout, state) the run's own, resize the per-pair buffers and
- *  hand the layout to the solver. */
-static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
+ *  hand the layout to the solver. @p prev: the predictor's previous state
+ *  on @p layout (taken over), or NULL: the predictor starts over. */
+static int adopt_layout(sp_run *run, sp_layout *layout, double *state, double *prev) {
   sp_layout_destroy(&run->layout);
   free(run->state);
   free(run->state_old);
   free(run->source);
+  free(run->state_prev);
   run->layout = layout;
   run->state = state;
+  run->state_prev = prev;
+  run->prev_valid = prev != NULL;
   SP_ALLOC(run->state_old, 2 * (size_t)layout->n_pairs);
   SP_ALLOC(run->source, layout->n_pairs);
   return sp_solver_attach(run->solver, run->mesh, run->layout);
@@ -214,7 +227,20 @@ static int update_supports(sp_run *run, sp_energy_parts *after) {
   SP_CALL(sp_support_rebuild(run->support, run->layout, run->state,
                              always ? NULL : run->divided_now, &layout, &state, &correction));
   memset(run->divided_now, 0, (size_t)run->layout->n_cells);
-  SP_CALL(adopt_layout(run, layout, state));
+  double *prev = NULL;
+  if (run->prev_valid) { /* the last increment moves with (cell, node), 0 on new pairs */
+    const size_t n_old = 2 * (size_t)run->layout->n_pairs, n_new = 2 * (size_t)layout->n_pairs;
+    for (size_t i = 0; i < n_old; ++i) run->state_prev[i] = run->state[i] - run->state_prev[i];
+    prev = malloc(n_new * sizeof(double));
+    if (!prev) {
+      sp_layout_destroy(&layout);
+      free(state);
+      return sp_error_set(SP_ERR_MEMORY, "out of memory");
+    }
+    sp_layout_transfer(run->layout, run->state_prev, layout, prev, 0.0);
+    for (size_t i = 0; i < n_new; ++i) prev[i] = state[i] - prev[i];
+  }
+  SP_CALL(adopt_layout(run, layout, state, prev));
   SP_CALL(state_energy(run, after));
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            run->scene->division.observe_threshold, run->obs));
@@ -277,7 +303,9 @@ static int divide_cell(sp_run *run, int parent, double t, int step) {
     return rc;
   }
   sp_layout_destroy(&run->layout);
-  free(run->state); free(run->state_old); free(run->source);
+  free(run->state); free(run->state_old); free(run->source); free(run->state_prev);
+  run->state_prev = NULL; /* the predictor starts over after a division */
+  run->prev_valid = 0;
   run->layout = new_layout;
   run->state = new_state;
   run->state_old = new_old;
@@ -366,6 +394,11 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     if (since_division >= 0) /* paper algorithm 2 after a division */
       dt_try = fmin(dt_try, sp_division_dt(tc->dt, dv->n_div, dv->m, since_division + 1));
     memcpy(run->state_old, run->state, n_values * sizeof(double));
+    if (run->prev_valid) { /* solver.predictor linear: Newton starts from the extrapolation */
+      const double r = fmin(dt_try / run->dt_prev, SP_PREDICTOR_MAX_RATIO);
+      for (size_t i = 0; i < n_values; ++i)
+        run->state[i] = run->state_old[i] + r * (run->state_old[i] - run->state_prev[i]);
+    }
     if (run->scene->source.rate > 0) {
       rc = sp_source_fill(run->layout, run->state_old, n_cells, run->source_on,
                           run->scene->source.rate, run->source);
@@ -442,6 +475,15 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     sum->newton_its += report.newton_its;
     sum->factorisations += report.factorisations;
     seconds.factorisations = report.factorisations;
+    if (run->scene->solver.predictor == SP_PREDICT_LINEAR) {
+      if (!run->state_prev) {
+        run->state_prev = malloc(n_values * sizeof(double));
+        if (!run->state_prev) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
+      }
+      memcpy(run->state_prev, run->state_old, n_values * sizeof(double));
+      run->dt_prev = dt_try;
+      run->prev_valid = 1;
+    }
     seconds.residual_rise = 0;
     for (int i = 1; i < report.n_residuals; ++i)
       seconds.residual_rise =
@@ -512,6 +554,7 @@ static void run_free(sp_run *run) {
   sp_mesh_destroy(&run->mesh);
   free(run->state);
   free(run->state_old);
+  free(run->state_prev);
   free(run->obs);
   free(run->energy_t);
   free(run->energy_total);
@@ -616,7 +659,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
       return sp_error_set(SP_ERR_MEMORY, "out of memory for the local layout");
     }
     sp_layout_transfer(run->layout, run->state, layout, state, 0.0);
-    SP_CALL(adopt_layout(run, layout, state));
+    SP_CALL(adopt_layout(run, layout, state, NULL));
     SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold, run->obs));
   } else {
     SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
