@@ -36,9 +36,10 @@ class SuperLUDist final : public DirectSolver {
     superlu_gridinit(comm, nprow, P / nprow, &grid_);
     set_default_options_dist(&options_);
     options_.PrintStat = NO;
-    // Defaults kept: Equil = YES, RowPerm = LargeDiag_MC64, ColPerm =
-    // METIS_AT_PLUS_A, IterRefine = SLU_DOUBLE (one refinement step makes
-    // the solves as accurate as SuperLU's partial pivoting here).
+    // Defaults kept: Equil = YES, RowPerm = LargeDiag_MC64, IterRefine =
+    // SLU_DOUBLE (one refinement step makes the solves as accurate as
+    // SuperLU's partial pivoting here). ColPerm: METIS on the pair graph
+    // (pair_ordering), given as MY_PERMC.
   }
   ~SuperLUDist() override {
     release();
@@ -59,6 +60,11 @@ class SuperLUDist final : public DirectSolver {
       col_saved_.assign(A.col, A.col + nnz);
       dScalePermstructInit(n_, n_, &scale_perm_);
       dLUstructInit(n_, &lu_);
+      // Pairs of rows (c, mu) on every rank: order the pair graph.
+      int pairs = A.n_rows % 2 == 0 && A.first_row % 2 == 0 && n_ % 2 == 0, all_pairs = 0;
+      MPI_Allreduce(&pairs, &all_pairs, 1, MPI_INT, MPI_MIN, grid_.comm);
+      if (all_pairs) pair_ordering(A, scale_perm_.perm_c);
+      options_.ColPerm = all_pairs ? MY_PERMC : METIS_AT_PLUS_A;
       have_structs_ = true;
       options_.Fact = DOFACT;
       ++symbolic_;
@@ -144,6 +150,56 @@ class SuperLUDist final : public DirectSolver {
   int symbolic_count() const override { return symbolic_; }
 
  private:
+  // METIS (as SuperLU_DIST calls it, on A + A^T) on the graph of the
+  // (cell, node) pairs instead of the unknowns: the two unknowns of a pair
+  // (c and mu) have the same couplings, so the pair graph holds the same
+  // structure with a quarter of the edges; each pair's two unknowns take
+  // consecutive places. perm_c[j]: the place of column j. Every rank
+  // computes it from the whole pattern, as SuperLU_DIST does.
+  void pair_ordering(const CsrRows &A, int_t *perm_c) {
+    const int my_pairs = A.n_rows / 2;
+    std::vector<int> len(my_pairs), col, row;
+    for (int r = 0; r < my_pairs; ++r) {
+      row.clear();
+      for (int k = A.row_ptr[2 * r]; k < A.row_ptr[2 * r + 2]; ++k) row.push_back(A.col[k] / 2);
+      std::sort(row.begin(), row.end());
+      row.erase(std::unique(row.begin(), row.end()), row.end());
+      len[r] = (int)row.size();
+      col.insert(col.end(), row.begin(), row.end());
+    }
+    int P = 1;
+    MPI_Comm_size(grid_.comm, &P);
+    const int my_nnz = (int)col.size();
+    std::vector<int> pairs(P), nnzs(P), pair_at(P, 0), nnz_at(P, 0);
+    MPI_Allgather(&my_pairs, 1, MPI_INT, pairs.data(), 1, MPI_INT, grid_.comm);
+    MPI_Allgather(&my_nnz, 1, MPI_INT, nnzs.data(), 1, MPI_INT, grid_.comm);
+    for (int r = 1; r < P; ++r) {
+      pair_at[r] = pair_at[r - 1] + pairs[r - 1];
+      nnz_at[r] = nnz_at[r - 1] + nnzs[r - 1];
+    }
+    const int n_pairs = pair_at[P - 1] + pairs[P - 1], nnz = nnz_at[P - 1] + nnzs[P - 1];
+    std::vector<int> all_len(n_pairs);
+    std::vector<int_t> rowind(nnz), colptr(n_pairs + 1, 0), order(n_pairs);
+    MPI_Allgatherv(len.data(), my_pairs, MPI_INT, all_len.data(), pairs.data(), pair_at.data(),
+                   MPI_INT, grid_.comm);
+    MPI_Allgatherv(col.data(), my_nnz, MPI_INT, rowind.data(), nnzs.data(), nnz_at.data(),
+                   MPI_INT, grid_.comm);
+    for (int p = 0; p < n_pairs; ++p) colptr[p + 1] = colptr[p] + all_len[p];
+    std::vector<double> values(nnz, 1.0);  // not read: the ordering needs the pattern only
+    NCformat store{nnz, values.data(), rowind.data(), colptr.data()};
+    SuperMatrix G;
+    G.Stype = SLU_NC;
+    G.Dtype = SLU_D;
+    G.Mtype = SLU_GE;
+    G.nrow = G.ncol = n_pairs;
+    G.Store = &store;
+    get_perm_c_dist(grid_.iam, METIS_AT_PLUS_A, &G, order.data());
+    for (int p = 0; p < n_pairs; ++p) {
+      perm_c[2 * p] = 2 * order[p];
+      perm_c[2 * p + 1] = 2 * order[p] + 1;
+    }
+  }
+
   bool pdgssvx_solve(double *x, int ld, int nrhs, std::string &why) {
     options_.Fact = FACTORED;
     SuperLUStat_t stat;
