@@ -1,8 +1,8 @@
 /* solver.predictor = linear: Newton starts from the last state plus its
  * last increment x min(dt / dt_last, 2), against the last state (none).
- * - A pushed cell on local supports (tests/scenes/local_push.yaml, 50
- *   steps, its supports change as it moves: the increment moves with
- *   (cell, node)): fewer Newton iterations over the run, the same steps,
+ * - A pushed cell on local supports (tests/scenes/local_push.yaml to
+ *   t = 0.01, 72 steps; its supports change as it moves: the increment
+ *   moves with (cell, node)): fewer Newton iterations over the run, the same steps,
  *   the energy at every step and every cell's mass and centre at the end
  *   the same to the Newton tolerance (1e-8 relative, centres 1e-7), every
  *   cell's mass conserved to 1e-10 across the support changes.
