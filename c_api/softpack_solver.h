@@ -39,6 +39,10 @@ enum {
   SP_SOLVER_MUMPS = 2,
   SP_SOLVER_KLU2 = 3
 };
+/** SuperLU_DIST's fill-reducing column order: METIS on the graph of the
+ *  (cell, node) pairs (c and mu of a pair together), or on the unknowns
+ *  (SuperLU_DIST's own METIS_AT_PLUS_A). */
+enum { SP_SOLVER_ORDER_PAIRS = 0, SP_SOLVER_ORDER_UNKNOWNS = 1 };
 
 typedef struct sp_solver_s *sp_solver;
 
@@ -57,6 +61,7 @@ typedef struct {
    *  of the step's first ||F_0|| (it is retried with a smaller dt without
    *  spending the rest of newton_max_its). 0: off; otherwise > 1. */
   double newton_divergence;
+  int ordering;  /**< SP_SOLVER_ORDER_* (SuperLU_DIST only); 0: pairs */
 } sp_solver_options;
 
 /** The mesh, borrowed (must outlive the solver's use of it). */

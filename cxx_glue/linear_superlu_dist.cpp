@@ -27,7 +27,7 @@ namespace {
 
 class SuperLUDist final : public DirectSolver {
  public:
-  explicit SuperLUDist(MPI_Comm comm) {
+  SuperLUDist(MPI_Comm comm, bool pair_order) : pair_order_(pair_order) {
     int P = 1;
     MPI_Comm_size(comm, &P);
     // The squarest grid with nprow <= npcol (SuperLU_DIST prefers wide grids).
@@ -39,7 +39,7 @@ class SuperLUDist final : public DirectSolver {
     // Defaults kept: Equil = YES, RowPerm = LargeDiag_MC64, IterRefine =
     // SLU_DOUBLE (one refinement step makes the solves as accurate as
     // SuperLU's partial pivoting here). ColPerm: METIS on the pair graph
-    // (pair_ordering), given as MY_PERMC.
+    // (pair_ordering), given as MY_PERMC, or METIS_AT_PLUS_A.
   }
   ~SuperLUDist() override {
     release();
@@ -61,7 +61,8 @@ class SuperLUDist final : public DirectSolver {
       dScalePermstructInit(n_, n_, &scale_perm_);
       dLUstructInit(n_, &lu_);
       // Pairs of rows (c, mu) on every rank: order the pair graph.
-      int pairs = A.n_rows % 2 == 0 && A.first_row % 2 == 0 && n_ % 2 == 0, all_pairs = 0;
+      int pairs = pair_order_ && A.n_rows % 2 == 0 && A.first_row % 2 == 0 && n_ % 2 == 0,
+          all_pairs = 0;
       MPI_Allreduce(&pairs, &all_pairs, 1, MPI_INT, MPI_MIN, grid_.comm);
       if (all_pairs) pair_ordering(A, scale_perm_.perm_c);
       options_.ColPerm = all_pairs ? MY_PERMC : METIS_AT_PLUS_A;
@@ -239,6 +240,7 @@ class SuperLUDist final : public DirectSolver {
   SuperMatrix A_;
   bool have_structs_ = false, have_lu_ = false, have_matrix_ = false, factored_once_ = false;
   int n_ = 0, m_loc_ = 0, fst_row_ = 0, symbolic_ = 0;
+  bool pair_order_;  // METIS on the pair graph (else on the unknowns)
   int solve_nrhs_ = 1, next_nrhs_ = 1;  // columns of the solve set-up, and of the next
   std::vector<int_t> ptr_saved_, col_saved_, ptr_, col_;
   std::vector<double> val_;
@@ -248,8 +250,8 @@ static_assert(sizeof(int_t) == sizeof(int), "SuperLU_DIST built with 64-bit indi
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm) {
-  return std::make_unique<SuperLUDist>(comm);
+std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order) {
+  return std::make_unique<SuperLUDist>(comm, pair_order);
 }
 
 }  // namespace sp

@@ -202,6 +202,8 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     throw std::runtime_error("solver.jacobian: unknown kind");
   if (!(options.jacobian_reuse >= 0 && options.jacobian_reuse < 1))
     throw std::runtime_error("solver.jacobian_reuse: expected 0 <= value < 1");
+  if (options.ordering != SP_SOLVER_ORDER_PAIRS && options.ordering != SP_SOLVER_ORDER_UNKNOWNS)
+    throw std::runtime_error("solver.ordering: unknown kind");
   if (!(options.newton_divergence == 0 || options.newton_divergence > 1))
     throw std::runtime_error("solver.newton_divergence: expected 0 (off) or a value > 1");
   const int P = comm_.NumProc();
@@ -211,7 +213,9 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       direct_ = P == 1 ? make_superlu()
                        : make_gathered(comm, comm_.MyPID() == 0 ? make_superlu() : nullptr);
       break;
-    case SP_SOLVER_SUPERLU_DIST: direct_ = make_superlu_dist(comm); break;
+    case SP_SOLVER_SUPERLU_DIST:
+      direct_ = make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS);
+      break;
     case SP_SOLVER_MUMPS: direct_ = make_amesos(comm, "Amesos_Mumps"); break;
     case SP_SOLVER_KLU2:
       // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several

@@ -128,6 +128,8 @@ static const cyaml_strval_t sp_linear_words[] = {
     {"superlu_dist", SP_LINEAR_SUPERLU_DIST},
     {"mumps", SP_LINEAR_MUMPS},
     {"klu2", SP_LINEAR_KLU2}};
+static const cyaml_strval_t sp_ordering_words[] = {
+    {"pairs", SP_ORDER_PAIRS}, {"unknowns", SP_ORDER_UNKNOWNS}};
 static const cyaml_strval_t sp_predictor_words[] = {
     {"none", SP_PREDICT_NONE}, {"linear", SP_PREDICT_LINEAR}};
 static const cyaml_strval_t sp_division_words[] = {
@@ -297,6 +299,11 @@ static const sp_key sp_keys[] = {
               "a step fails (and is retried with a smaller dt) as soon as an "
               "iteration's residual norm exceeds this multiple of the step's "
               "first one (0: off; otherwise > 1)"),
+    KEY_ENUM(SP_SEC_SOLVER, "ordering", solver.ordering, SP_ORDER_PAIRS,
+             sp_ordering_words, "-",
+             "superlu_dist's fill-reducing order: METIS on the graph of the "
+             "(cell, node) pairs (quicker to build) or on the unknowns "
+             "(SuperLU_DIST's own; a little less fill with hundreds of cells)"),
     KEY_ENUM(SP_SEC_SOLVER, "predictor", solver.predictor, SP_PREDICT_NONE,
              sp_predictor_words, "-",
              "Newton's initial guess: the last state (none) or the last state "

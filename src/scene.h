@@ -20,6 +20,8 @@ typedef enum { SP_PROFILE_TANH = 0, SP_PROFILE_SHARP = 1 } sp_profile_kind;
 typedef enum { SP_JAC_AD = 0, SP_JAC_HAND = 1, SP_JAC_FD = 2 } sp_jacobian_kind;
 /** Newton's initial guess: the last state, or extrapolated from the last two. */
 typedef enum { SP_PREDICT_NONE = 0, SP_PREDICT_LINEAR = 1 } sp_predictor_kind;
+/** SuperLU_DIST's column order: METIS on the (cell, node) pairs or on the unknowns. */
+typedef enum { SP_ORDER_PAIRS = 0, SP_ORDER_UNKNOWNS = 1 } sp_ordering_kind;
 typedef enum {
   SP_LINEAR_SUPERLU = 0,
   SP_LINEAR_SUPERLU_DIST = 1,
@@ -87,6 +89,7 @@ typedef struct {
   double newton_divergence; /**< fail a step once ||F_k|| > this x ||F_0||
                                  (0: off) */
   sp_predictor_kind predictor; /**< Newton's initial guess */
+  sp_ordering_kind ordering;   /**< SuperLU_DIST's column order */
 } sp_scene_solver;
 
 /** output: what is written and when. */
