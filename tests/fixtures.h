@@ -66,9 +66,17 @@ static inline void set_disk(const sp_mesh *mesh, const sp_layout *layout, double
   }
 }
 
+/** The unit square in 40 x 40 elements with every one of three cells on
+ *  every node: the problem of set_three_touching_disks. */
+static inline void three_cell_problem(sp_mesh **mesh, sp_layout **layout) {
+  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 40, 40, mesh));
+  CHECK_OK(sp_layout_create_full((*mesh)->n_nodes, 3, layout));
+}
+
 /** Three touching cells on the unit square (width d = sqrt(kappa / 2 alpha)
- *  of the paper's parameters): the typical step of test_newton and
- *  test_jacobian_reuse. */
+ *  of the paper's parameters): the typical step of test_newton,
+ *  test_jacobian_reuse, test_jacobian_hand, test_ordering and mpi_compare's
+ *  iterates. */
 static inline void set_three_touching_disks(const sp_mesh *mesh, const sp_layout *layout,
                                             double *state) {
   const double d = sqrt(1e-3 / 8);

@@ -268,14 +268,10 @@ static void newton_iterates(MPI_Comm comm, int linear, const sp_mesh *mesh, cons
 static int cmd_iterates(int argc, char **argv, int rank, int size) {
   sp_mesh *mesh;
   sp_layout *layout;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 40, 40, &mesh));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 3, &layout));
+  three_cell_problem(&mesh, &layout);
   const int n = 2 * layout->n_pairs;
   double *old = calloc(n, sizeof(double)), *guess = calloc(n, sizeof(double));
-  const double d = sqrt(1e-3 / 8);
-  set_disk(mesh, layout, old, 0, 0.35, 0.5, 0.15, d);
-  set_disk(mesh, layout, old, 1, 0.65, 0.5, 0.15, d);
-  set_disk(mesh, layout, old, 2, 0.5, 0.75, 0.11, d);
+  set_three_touching_disks(mesh, layout, old);
   /* x_0: the old state with a perturbed c, so that every iterate moves. */
   for (int i = 0; i < n; ++i) guess[i] = old[i] + (i % 2 == 0 ? 0.01 * sin(0.37 * i) : 0.0);
   double *ref = malloc((size_t)N_ITERATES * n * sizeof(double));

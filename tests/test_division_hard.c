@@ -54,6 +54,23 @@ static void run_capturing_stderr(const sp_scene *scene, const char *out, const c
   close(saved);
 }
 
+/* The lines of @p path that hold every one of @p needles (NULL-terminated);
+ * the first of them is printed after @p label unless it is NULL. */
+static int count_lines_with(const char *path, const char *const *needles, const char *label) {
+  int n = 0;
+  FILE *f = fopen(path, "r");
+  char line[2048];
+  while (f && fgets(line, sizeof line, f)) {
+    int all = 1;
+    for (const char *const *s = needles; *s && all; ++s) all = strstr(line, *s) != NULL;
+    if (!all) continue;
+    if (n == 0 && label) printf("%s%s", label, line);
+    ++n;
+  }
+  if (f) fclose(f);
+  return n;
+}
+
 /* The |F| histories of the failed attempts reported in @p err_path (the
  * text after "|F|: " up to ";"), at most @p max; returns their number. */
 static int failed_histories(const char *err_path, char hist[][1024], int max) {
@@ -142,11 +159,8 @@ static void check_divergence_ratio(void) {
           at(&a, i, "residual_rise"));
   free(a.v);
   free(b.v);
-  FILE *f = fopen("hard_div_on_stderr.txt", "r");
-  char line[2048];
-  int named = 0;
-  while (f && fgets(line, sizeof line, f)) named += strstr(line, "diverged: |F| above 100 x") != NULL;
-  if (f) fclose(f);
+  static const char *const diverged[] = {"diverged: |F| above 100 x", NULL};
+  const int named = count_lines_with("hard_div_on_stderr.txt", diverged, NULL);
   CHECK(named == on.failed_attempts, "%d of %d failures say why", named, on.failed_attempts);
 }
 
@@ -175,17 +189,10 @@ int main(int argc, char **argv) {
   CHECK(sum.n_cells == 2, "%d cells", sum.n_cells);
   CHECK(sum.failed_attempts >= 1, "Newton never failed after the sharp cut at the full dt");
   CHECK(sum.dt_smallest < scene->time.dt, "smallest dt %g", sum.dt_smallest);
-  int reported = 0, logged = 0;
-  FILE *f = fopen("hard_retry_stderr.txt", "r");
-  char line[2048];
-  while (f && fgets(line, sizeof line, f)) {
-    if (strstr(line, "no convergence in 4 Newton iterations") && strstr(line, "|F|:") &&
-        strstr(line, "retried with dt = ")) {
-      if (reported == 0) printf("reported: %s", line);
-      ++reported;
-    }
-  }
-  if (f) fclose(f);
+  static const char *const retried[] = {"no convergence in 4 Newton iterations", "|F|:",
+                                         "retried with dt = ", NULL};
+  const int reported = count_lines_with("hard_retry_stderr.txt", retried, "reported: ");
+  int logged = 0;
   csv_table e;
   CHECK(csv_read("hard_retry/energy.csv", &e) == 0, "hard_retry/energy.csv unreadable");
   for (int i = 0; i < e.n_rows; ++i) logged += (int)at(&e, i, "failed_attempts");

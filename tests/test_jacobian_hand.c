@@ -107,18 +107,14 @@ static void division_cut(void) {
 /* Steps of a 3-cell scene with ad and with hand from identical inputs. */
 static void newton_same_iterations(void) {
   sp_mesh *mesh;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 40, 40, &mesh));
   sp_layout *layout;
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 3, &layout));
+  three_cell_problem(&mesh, &layout);
   sp_solver s_ad = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
   sp_solver s_hand = make_solver(mesh, layout, SP_SOLVER_JAC_HAND);
   const int n = 2 * layout->n_pairs;
   double *u_ad = calloc(n, sizeof(double)), *u_hand = calloc(n, sizeof(double));
   double *old_ad = calloc(n, sizeof(double)), *old_hand = calloc(n, sizeof(double));
-  const double d = sqrt(1e-3 / 8);
-  set_disk(mesh, layout, u_ad, 0, 0.35, 0.5, 0.15, d); /* touching: test_newton.c */
-  set_disk(mesh, layout, u_ad, 1, 0.65, 0.5, 0.15, d);
-  set_disk(mesh, layout, u_ad, 2, 0.5, 0.75, 0.11, d);
+  set_three_touching_disks(mesh, layout, u_ad);
   memcpy(u_hand, u_ad, n * sizeof(double));
   double t = 0.0, dt = 1e-4;
   int total_its = 0;

@@ -8,8 +8,7 @@ int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   sp_mesh *mesh;
   sp_layout *layout;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 40, 40, &mesh));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 3, &layout));
+  three_cell_problem(&mesh, &layout);
   sp_solver s = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
   const int n = 2 * layout->n_pairs;
   double *state = calloc(n, sizeof(double)), *old = calloc(n, sizeof(double));

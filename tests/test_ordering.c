@@ -16,8 +16,7 @@ int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   sp_mesh *mesh;
   sp_layout *layout;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 40, 40, &mesh));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 3, &layout));
+  three_cell_problem(&mesh, &layout);
   sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU_DIST);
   opt.ordering = SP_SOLVER_ORDER_PAIRS;
   sp_solver pairs = make_solver_opts(mesh, layout, &opt);
