@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace sp {
 namespace {
@@ -118,80 +119,84 @@ class ResidualRecorder : public NOX::Observer {
   Solver &s_;
 };
 
-// Converged only after at least one Newton update: the update conserves
-// each cell's mass to round-off, a residual tolerance alone would not.
-class AtLeastOneIteration : public NOX::StatusTest::Generic {
+// Our status tests: `outcome` once a condition holds, Unconverged before;
+// print() names the condition.
+class ConditionTest : public NOX::StatusTest::Generic {
  public:
+  ConditionTest(NOX::StatusTest::StatusType outcome, std::string what)
+      : outcome_(outcome), what_(std::move(what)) {}
   NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic &solver,
                                           NOX::StatusTest::CheckType) override {
-    status_ = solver.getNumIterations() >= 1 ? NOX::StatusTest::Converged
-                                             : NOX::StatusTest::Unconverged;
+    status_ = holds(solver) ? outcome_ : NOX::StatusTest::Unconverged;
     return status_;
   }
   NOX::StatusTest::StatusType getStatus() const override { return status_; }
   std::ostream &print(std::ostream &s, int indent) const override {
     for (int i = 0; i < indent; ++i) s << ' ';
-    s << status_ << "At least one Newton update\n";
+    s << status_ << what_ << "\n";
     return s;
   }
 
+ protected:
+  virtual bool holds(const NOX::Solver::Generic &solver) const = 0;
+
  private:
+  NOX::StatusTest::StatusType outcome_;
+  std::string what_;
   NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unevaluated;
+};
+
+// Converged only after at least one Newton update: the update conserves
+// each cell's mass to round-off, a residual tolerance alone would not.
+class AtLeastOneIteration : public ConditionTest {
+ public:
+  AtLeastOneIteration() : ConditionTest(NOX::StatusTest::Converged, "At least one Newton update") {}
+
+ protected:
+  bool holds(const NOX::Solver::Generic &solver) const override {
+    return solver.getNumIterations() >= 1;
+  }
 };
 
 // Modified Newton's iteration limit: this many factorisations (each
 // iteration that reused one was cheap, and followed one that cut ||F|| by
 // jacobian_reuse).
-class FactorisationLimit : public NOX::StatusTest::Generic {
+class FactorisationLimit : public ConditionTest {
  public:
-  FactorisationLimit(const Solver &s, int limit) : s_(s), limit_(limit) {}
-  NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic &,
-                                          NOX::StatusTest::CheckType) override {
-    status_ = s_.step_factorisations() >= limit_ ? NOX::StatusTest::Failed
-                                                 : NOX::StatusTest::Unconverged;
-    return status_;
-  }
-  NOX::StatusTest::StatusType getStatus() const override { return status_; }
-  std::ostream &print(std::ostream &s, int indent) const override {
-    for (int i = 0; i < indent; ++i) s << ' ';
-    s << status_ << "Factorisations < " << limit_ << "\n";
-    return s;
+  FactorisationLimit(const Solver &s, int limit)
+      : ConditionTest(NOX::StatusTest::Failed, "Factorisations < " + std::to_string(limit)),
+        s_(s), limit_(limit) {}
+
+ protected:
+  bool holds(const NOX::Solver::Generic &) const override {
+    return s_.step_factorisations() >= limit_;
   }
 
  private:
   const Solver &s_;
   int limit_;
-  NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unevaluated;
 };
 
 // Fails a step as soon as ||F_k|| > ratio ||F_0|| (sp_solver_options.
 // newton_divergence): the failed attempts of a packed aggregate all blow
 // up within a few iterations, and the retry with a smaller dt comes the
 // same whether the step fails now or after newton_max_its iterations.
-class RelativeDivergence : public NOX::StatusTest::Generic {
+class RelativeDivergence : public ConditionTest {
  public:
-  RelativeDivergence(const Solver &s, double ratio) : s_(s), ratio_(ratio) {}
-  NOX::StatusTest::StatusType checkStatus(const NOX::Solver::Generic &solver,
-                                          NOX::StatusTest::CheckType) override {
-    // ||F_0|| was recorded before the first iteration (ResidualRecorder).
-    const double first = s_.step_first_norm();
-    status_ = solver.getNumIterations() >= 1 &&
-                      solver.getSolutionGroup().getNormF() > ratio_ * first
-                  ? NOX::StatusTest::Failed
-                  : NOX::StatusTest::Unconverged;
-    return status_;
-  }
-  NOX::StatusTest::StatusType getStatus() const override { return status_; }
-  std::ostream &print(std::ostream &s, int indent) const override {
-    for (int i = 0; i < indent; ++i) s << ' ';
-    s << status_ << "||F|| <= " << ratio_ << " ||F_0||\n";
-    return s;
+  RelativeDivergence(const Solver &s, double ratio)
+      : ConditionTest(NOX::StatusTest::Failed, "||F|| <= " + std::to_string(ratio) + " ||F_0||"),
+        s_(s), ratio_(ratio) {}
+
+ protected:
+  // ||F_0|| was recorded before the first iteration (ResidualRecorder).
+  bool holds(const NOX::Solver::Generic &solver) const override {
+    return solver.getNumIterations() >= 1 &&
+           solver.getSolutionGroup().getNormF() > ratio_ * s_.step_first_norm();
   }
 
  private:
   const Solver &s_;
   double ratio_;
-  NOX::StatusTest::StatusType status_ = NOX::StatusTest::Unevaluated;
 };
 
 }  // namespace
