@@ -157,7 +157,8 @@ int main(void) {
                                     {3.14159265358979, 2.0 / 7.0, 0, 0},
                                     {1e17 + 3, -0.0, 5e-324, 1.1}};
   const double shape[3] = {0.0, 1.0 / 9.0, 123.456};
-  const sp_step_costs seconds = {2.5, 0.25, 2.0, 0.125, 0.5, 1, 123456789, 3, 2, 17, 37.5}; /* exact in %.4g */
+  /* exact in %.4g */
+  const sp_step_costs seconds = {2.5, 0.25, 2.0, 0.125, 0.5, 1, 123456789, 3, 2, 17, 37.5};
   for (int r = 0; r < 3; ++r)
     CHECK_OK(sp_output_energy(out, r * 10, tv[r], 2e-4 / 3.0, r + 2, 2,
                               &parts[r], shape[r], r == 1 ? &seconds : NULL));
