@@ -27,19 +27,7 @@ echo "| cells | unknowns | unknowns / node | Newton its | s/step | s/step/cell |
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 ref=""
 for n in "${sizes[@]}"; do
-  # the scene without its cells, then n lattice sites nearest the centre
-  # whose disks keep 0.06 from the ellipse
-  scene_without_cells inputs/aggregate_256.yaml > "$tmp/p$n.yaml"
-  echo "cells:" >> "$tmp/p$n.yaml"
-  awk -v n="$n" 'BEGIN { r = 0.065; h = 0.15; a = 2.0 - r - 0.06; b = 1.0 - r - 0.06
-      for (j = -10; j <= 10; ++j) for (i = -20; i <= 20; ++i) {
-        x = (i + (j % 2 ? 0.5 : 0)) * h; y = j * h * sqrt(3) / 2
-        if ((x / a) ^ 2 + (y / b) ^ 2 <= 1) printf "%.12f %.4f %.4f\n", x * x + 4 * y * y + 1e-9 * (i + 40 * j), x, y }
-    }' | sort -g > "$tmp/sites"
-  awk -v n="$n" 'NR <= n { printf "  - {x: %s, y: %s, radius: 0.065}\n", $2, $3 }' "$tmp/sites" \
-    >> "$tmp/p$n.yaml"
-  got=$(grep -c '^  - {x:' "$tmp/p$n.yaml")
-  [ "$got" -eq "$n" ] || { echo "only $got lattice sites fit for $n cells" >&2; exit 2; }
+  packed_scene "$n" "$tmp/p$n.yaml"
   /usr/bin/time -f "%M" -o "$tmp/p$n.mem" build/softpack run "$tmp/p$n.yaml" --out "$tmp/o$n" \
       --set division.criterion=none --set source.rate=0 --set time.dt="$dt" \
       --set time.t_end="$t_end" --set output.pictures=false --set output.every=1000000 \

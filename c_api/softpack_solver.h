@@ -32,12 +32,14 @@ enum {
   SP_SOLVER_JAC_FD = 2,
   SP_SOLVER_JAC_AD_DFAD = 3
 };
-/** Direct linear solver. */
+/** Linear solver of each Newton iteration: direct, or GMRES preconditioned
+ *  by ILU(k) (additive Schwarz, one ILU per rank, under MPI). */
 enum {
   SP_SOLVER_SUPERLU = 0,
   SP_SOLVER_SUPERLU_DIST = 1,
   SP_SOLVER_MUMPS = 2,
-  SP_SOLVER_KLU2 = 3
+  SP_SOLVER_KLU2 = 3,
+  SP_SOLVER_GMRES_ILU = 4
 };
 /** SuperLU_DIST's fill-reducing column order: METIS on the graph of the
  *  (cell, node) pairs (c and mu of a pair together), or on the unknowns
@@ -62,6 +64,10 @@ typedef struct {
    *  spending the rest of newton_max_its). 0: off; otherwise > 1. */
   double newton_divergence;
   int ordering;  /**< SP_SOLVER_ORDER_* (SuperLU_DIST only); 0: pairs */
+  /** SP_SOLVER_GMRES_ILU only: the ILU(k) level of fill (0 = 2) and the
+   *  relative residual of a linear solve (0 = 1e-10). */
+  int ilu_fill;
+  double krylov_tol;
 } sp_solver_options;
 
 /** The mesh, borrowed (must outlive the solver's use of it). */

@@ -68,6 +68,15 @@ std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order);
 // Amesos (v1) on an Epetra copy of the rows: which = "Amesos_Mumps" or
 // "Amesos_Klu". Throws if Amesos was built without it.
 std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &which);
+// GMRES preconditioned by ILU(fill) (additive Schwarz across ranks), to a
+// residual of tolerance x |b|.
+struct KrylovOptions {
+  int fill = 2;
+  int restart = 100;
+  int max_iterations = 500;
+  double tolerance = 1e-10;
+};
+std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options);
 
 }  // namespace sp
 #endif

@@ -231,6 +231,15 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
                                  "); use superlu_dist or mumps with several processes");
       direct_ = make_amesos(comm, "Amesos_Klu");
       break;
+    case SP_SOLVER_GMRES_ILU: {
+      KrylovOptions k;
+      if (options.ilu_fill != 0) k.fill = options.ilu_fill;
+      if (options.krylov_tol != 0) k.tolerance = options.krylov_tol;
+      if (k.fill < 0 || !(k.tolerance > 0 && k.tolerance < 1))
+        throw std::runtime_error("solver.ilu_fill / krylov_tol: expected fill >= 0 and 0 < tol < 1");
+      direct_ = make_krylov(comm, k);
+      break;
+    }
     default: throw std::runtime_error("solver.linear: unknown kind");
   }
 }
@@ -628,7 +637,14 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
 
   auto solver = NOX::Solver::buildSolver(group, all, params);
   last_error.clear();
-  StatusType status = solver->solve();
+  // A failed linear solve (applyJacobianInverse false, last_error set):
+  // NOX's Newton direction throws; the attempt failed, as a diverging one.
+  StatusType status = Failed;
+  try {
+    status = solver->solve();
+  } catch (...) {
+    if (last_error.empty()) throw;
+  }
   report.newton_its = solver->getNumIterations();
   report.factorisations = step_factorisations_;
   report.n_residuals = (int)std::min<size_t>(step_norms_.size(), SP_MAX_NEWTON_HISTORY);

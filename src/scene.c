@@ -127,7 +127,8 @@ static const cyaml_strval_t sp_linear_words[] = {
     {"superlu", SP_LINEAR_SUPERLU},
     {"superlu_dist", SP_LINEAR_SUPERLU_DIST},
     {"mumps", SP_LINEAR_MUMPS},
-    {"klu2", SP_LINEAR_KLU2}};
+    {"klu2", SP_LINEAR_KLU2},
+    {"gmres_ilu", SP_LINEAR_GMRES_ILU}};
 static const cyaml_strval_t sp_ordering_words[] = {
     {"pairs", SP_ORDER_PAIRS}, {"unknowns", SP_ORDER_UNKNOWNS}};
 static const cyaml_strval_t sp_predictor_words[] = {
@@ -278,7 +279,10 @@ static const sp_key sp_keys[] = {
              "Newton Jacobian: automatic differentiation, hand-coded or "
              "finite differences"),
     KEY_ENUM(SP_SEC_SOLVER, "linear", solver.linear, SP_LINEAR_SUPERLU,
-             sp_linear_words, "-", "direct sparse solver of each Newton step"),
+             sp_linear_words, "-",
+             "linear solver of each Newton step: direct (superlu, "
+             "superlu_dist, mumps, klu2) or GMRES with an ILU(k) "
+             "preconditioner (gmres_ilu)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
               ABOVE(0.0), BELOW(1.0), "-",
               "Newton: residual reduction relative to the first residual"),
@@ -304,6 +308,15 @@ static const sp_key sp_keys[] = {
              "superlu_dist's fill-reducing order: METIS on the graph of the "
              "(cell, node) pairs (quicker to build) or on the unknowns "
              "(SuperLU_DIST's own; a little less fill with hundreds of cells)"),
+    KEY_INT(SP_SEC_SOLVER, "ilu_fill", solver.ilu_fill, 2, AT_LEAST(1), AT_MOST(20), "-",
+            "gmres_ilu: level of fill of the incomplete LU preconditioner "
+            "(ILU(k); 1 stalls on these matrices, 2 is the cheapest that "
+            "converges well)"),
+    KEY_FLOAT(SP_SEC_SOLVER, "krylov_tol", solver.krylov_tol, 1e-10, ABOVE(0.0), AT_MOST(1e-3),
+              "-",
+              "gmres_ilu: a linear solve ends when its residual is below this "
+              "fraction of the right-hand side's norm (a solve not there in "
+              "500 iterations fails the Newton attempt)"),
     KEY_ENUM(SP_SEC_SOLVER, "predictor", solver.predictor, SP_PREDICT_NONE,
              sp_predictor_words, "-",
              "Newton's initial guess: the last state (none) or the last state "

@@ -26,7 +26,8 @@ typedef enum {
   SP_LINEAR_SUPERLU = 0,
   SP_LINEAR_SUPERLU_DIST = 1,
   SP_LINEAR_MUMPS = 2,
-  SP_LINEAR_KLU2 = 3
+  SP_LINEAR_KLU2 = 3,
+  SP_LINEAR_GMRES_ILU = 4
 } sp_linear_kind;
 
 /** mesh: the domain and its discretisation. */
@@ -84,6 +85,8 @@ typedef struct {
   double newton_rtol;  /**< relative residual tolerance */
   double newton_atol;  /**< absolute residual tolerance (unscaled 2-norm) */
   int newton_max_its;  /**< iterations before a step counts as failed */
+  int ilu_fill;        /**< gmres_ilu: ILU(k) level of fill */
+  double krylov_tol;   /**< gmres_ilu: relative residual of a linear solve */
   double jacobian_reuse; /**< modified Newton: keep the factorisation while
                               each iteration cuts ||F|| by this (0: never) */
   double newton_divergence; /**< fail a step once ||F_k|| > this x ||F_0||

@@ -28,12 +28,14 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
 void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt) {
   static const int jacobian[] = {SP_SOLVER_JAC_AD, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD};
   static const int linear[] = {SP_SOLVER_SUPERLU, SP_SOLVER_SUPERLU_DIST,
-                               SP_SOLVER_MUMPS, SP_SOLVER_KLU2};
+                               SP_SOLVER_MUMPS, SP_SOLVER_KLU2, SP_SOLVER_GMRES_ILU};
   opt->jacobian = jacobian[scene->solver.jacobian];
   opt->linear = linear[scene->solver.linear];
   opt->newton_rtol = scene->solver.newton_rtol;
   opt->newton_atol = scene->solver.newton_atol;
   opt->newton_max_its = scene->solver.newton_max_its;
+  opt->ilu_fill = scene->solver.ilu_fill;
+  opt->krylov_tol = scene->solver.krylov_tol;
   opt->jacobian_reuse = scene->solver.jacobian_reuse;
   opt->newton_divergence = scene->solver.newton_divergence;
   opt->ordering = scene->solver.ordering == SP_ORDER_PAIRS ? SP_SOLVER_ORDER_PAIRS

@@ -1,0 +1,97 @@
+/* solver.linear = gmres_ilu: GMRES preconditioned by ILU(k) solves each
+ * Newton iteration to krylov_tol x |b| instead of exactly. On three
+ * touching cells (paper parameters, 3 steps of dt = 1e-4) it takes the
+ * same Newton iterations as serial SuperLU and the states agree to 1e-9 of
+ * the largest value, at ILU(2) and ILU(4) (the default 1e-10 is tight
+ * enough that Newton cannot tell the difference). A tolerance GMRES cannot
+ * reach in its 500 iterations makes the step fail with a reason naming
+ * GMRES and leaves the state untouched (the stepper retries with a smaller
+ * dt), instead of ending the run. Bad fill or tolerance is refused. */
+#include <string.h>
+
+#include "fixtures.h"
+
+enum { N_STEPS = 3 };
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  sp_mesh *mesh;
+  sp_layout *layout;
+  three_cell_problem(&mesh, &layout);
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_GMRES_ILU);
+  opt.ilu_fill = 2;
+  sp_solver ilu2 = make_solver_opts(mesh, layout, &opt);
+  opt.ilu_fill = 4;
+  sp_solver ilu4 = make_solver_opts(mesh, layout, &opt);
+  sp_solver serial = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU);
+  sp_solver solvers[3] = {ilu2, ilu4, serial};
+  const char *names[3] = {"ILU(2)", "ILU(4)", "SuperLU"};
+  const int n = 2 * layout->n_pairs;
+  double *x[3], *old = calloc(n, sizeof(double));
+  for (int s = 0; s < 3; ++s) {
+    x[s] = calloc(n, sizeof(double));
+    set_three_touching_disks(mesh, layout, x[s]);
+  }
+  sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
+  for (int step = 0; step < N_STEPS; ++step) {
+    int its[3];
+    for (int s = 0; s < 3; ++s) {
+      sp_step_report rep;
+      for (int i = 0; i < n; ++i) old[i] = x[s][i];
+      CHECK(sp_solver_step(solvers[s], &data, x[s], &rep) == 0, "%s, step %d: %s", names[s], step,
+            rep.reason);
+      its[s] = rep.newton_its;
+    }
+    double scale = 0, d2 = 0, d4 = 0;
+    for (int i = 0; i < n; ++i) {
+      scale = fmax(scale, fabs(x[2][i]));
+      d2 = fmax(d2, fabs(x[0][i] - x[2][i]));
+      d4 = fmax(d4, fabs(x[1][i] - x[2][i]));
+    }
+    printf("step %d: Newton iterations %d / %d / %d (ILU(2) / ILU(4) / SuperLU); states against "
+           "SuperLU %.2e / %.2e (of %.3g)\n",
+           step, its[0], its[1], its[2], d2, d4, scale);
+    CHECK(its[0] == its[2] && its[1] == its[2], "step %d: Newton iterations %d, %d against %d",
+          step, its[0], its[1], its[2]);
+    CHECK(d2 <= 1e-9 * scale && d4 <= 1e-9 * scale, "step %d: states differ by %.3e and %.3e",
+          step, d2, d4);
+  }
+
+  /* an unreachable tolerance: the step fails, the state stays */
+  opt.ilu_fill = 2;
+  opt.krylov_tol = 1e-30;
+  sp_solver strict = make_solver_opts(mesh, layout, &opt);
+  double *y = malloc(sizeof(double) * n);
+  for (int i = 0; i < n; ++i) old[i] = y[i] = x[0][i];
+  sp_step_report rep;
+  CHECK(sp_solver_step(strict, &data, y, &rep) == 1, "a step with krylov_tol 1e-30 succeeded");
+  printf("krylov_tol 1e-30: %s\n", rep.reason);
+  CHECK(strstr(rep.reason, "GMRES: no convergence") != NULL, "reason: %s", rep.reason);
+  CHECK(memcmp(y, x[0], sizeof(double) * n) == 0, "the failed step changed the state");
+  sp_solver_destroy(&strict);
+  free(y);
+
+  const struct {
+    int fill;
+    double tol;
+  } bad[] = {{-1, 1e-10}, {2, 1.5}, {2, -1e-8}};
+  for (size_t b = 0; b < sizeof bad / sizeof bad[0]; ++b) {
+    sp_solver s = NULL;
+    opt.ilu_fill = bad[b].fill;
+    opt.krylov_tol = bad[b].tol;
+    CHECK(sp_solver_create(MPI_COMM_WORLD, &opt, &s) != 0, "fill %d, tol %g accepted",
+          bad[b].fill, bad[b].tol);
+    CHECK(strstr(sp_solver_last_error(s), "solver.ilu_fill") != NULL, "message: %s",
+          sp_solver_last_error(s));
+    sp_solver_destroy(&s);
+  }
+  for (int s = 0; s < 3; ++s) {
+    sp_solver_destroy(&solvers[s]);
+    free(x[s]);
+  }
+  free(old);
+  sp_layout_destroy(&layout);
+  sp_mesh_destroy(&mesh);
+  MPI_Finalize();
+  TEST_DONE();
+}
