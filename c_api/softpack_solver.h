@@ -134,6 +134,8 @@ typedef struct {
   int converged;        /**< 1 only if Newton met its tolerance */
   int newton_its;
   int factorisations;   /**< Jacobians filled and factored (<= newton_its) */
+  long linear_its;      /**< iterative solver (gmres_ilu): its GMRES iterations
+                             over the step's linear solves; 0 for direct ones */
   int n_residuals;      /**< entries of residual_norms */
   double residual_norms[SP_MAX_NEWTON_HISTORY]; /**< ||F|| per iteration */
   double t_assembly;    /**< seconds: residual + Jacobian fills */

@@ -50,6 +50,8 @@ class DirectSolver {
   // How many columns the solves after the next factor() will take (a
   // backend whose solve set-up depends on it prepares for that count).
   virtual void set_rhs_count(int) {}
+  // Inner iterations of all solves so far (iterative solvers; 0 otherwise).
+  virtual long iterations() const { return 0; }
   // Number of symbolic analyses done (for tests of the reuse).
   virtual int symbolic_count() const = 0;
 };

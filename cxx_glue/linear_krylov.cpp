@@ -60,7 +60,6 @@ class KrylovSolver final : public DirectSolver {
     gmres_->Iterate(o_.max_iterations, o_.tolerance);
     const double *status = gmres_->GetAztecStatus();
     iterations_ += (long)status[AZ_its];
-    ++solves_;
     if (status[AZ_why] != AZ_normal) {
       char text[128];
       std::snprintf(text, sizeof text,
@@ -73,6 +72,7 @@ class KrylovSolver final : public DirectSolver {
     return true;
   }
 
+  long iterations() const override { return iterations_; }
   int symbolic_count() const override { return symbolic_; }
 
  private:
@@ -83,7 +83,7 @@ class KrylovSolver final : public DirectSolver {
   std::unique_ptr<AztecOO> gmres_;
   bool factored_ = false;
   int symbolic_ = 0;
-  long iterations_ = 0, solves_ = 0;
+  long iterations_ = 0;
 };
 
 }  // namespace

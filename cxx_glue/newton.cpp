@@ -590,6 +590,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   step_factorisations_ = 0;
   step_norms_.clear();
   const double t_start = now();
+  const long linear_its_before = direct_->iterations();
   const Epetra_Map &map = assembly_->map();
   Epetra_Vector x0(map);
   for (int i = 0; i < map.NumMyElements(); ++i) x0[i] = state[map.GID(i)];
@@ -647,6 +648,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   }
   report.newton_its = solver->getNumIterations();
   report.factorisations = step_factorisations_;
+  report.linear_its = direct_->iterations() - linear_its_before;
   report.n_residuals = (int)std::min<size_t>(step_norms_.size(), SP_MAX_NEWTON_HISTORY);
   std::copy(step_norms_.begin(), step_norms_.begin() + report.n_residuals, report.residual_norms);
   report.t_assembly = t_assembly;

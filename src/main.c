@@ -72,13 +72,16 @@ static int cmd_run(int argc, char **argv, int rank) {
            sum.support_energy_rise, sum.unknowns_max);
   else if (rc == SP_OK && rank == 0)
     printf("softpack: at most %ld unknowns per step\n", sum.unknowns_max);
+  char gmres[64] = "";
+  if (sum.linear_its > 0)
+    snprintf(gmres, sizeof gmres, "; %ld GMRES iterations", sum.linear_its);
   if (rc == SP_OK && rank == 0)
     printf("softpack: %d steps to t = %.6g (%d failed attempts retried, smallest dt %.3g), "
-           "%ld Newton iterations (%ld factorisations, and %ld in failed attempts), %.1f s "
+           "%ld Newton iterations (%ld factorisations, and %ld in failed attempts%s), %.1f s "
            "(assembly %.1f, factorisation %.1f, solves %.1f); output in %s\n",
            sum.steps, sum.t_final, sum.failed_attempts, sum.dt_smallest, sum.newton_its,
-           sum.factorisations, sum.failed_factorisations, sum.wall_seconds, sum.t_assembly,
-           sum.t_factor, sum.t_solve, out_dir);
+           sum.factorisations, sum.failed_factorisations, gmres, sum.wall_seconds,
+           sum.t_assembly, sum.t_factor, sum.t_solve, out_dir);
   sp_scene_destroy(&scene);
   free(sets);
   return rc;

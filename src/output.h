@@ -30,20 +30,22 @@ int sp_output_open(const char *dir, sp_output *out);
  *  iterations with solver.jacobian_reuse), the failed attempts before
  *  it and their factorisations, and the largest rise of the residual norm
  *  over its first in the accepted attempt (below 1: |F| never rose; what
- *  solver.newton_divergence must stay above). */
+ *  solver.newton_divergence must stay above), and the accepted attempt's
+ *  GMRES iterations (solver.linear gmres_ilu; 0 with a direct solver). */
 typedef struct {
   double step, assembly, factorisation, solves, supports;
   int support_changed;
   long unknowns;
   int factorisations, failed_attempts, failed_factorisations;
   double residual_rise; /**< largest ||F_k|| / ||F_0|| of the accepted attempt */
+  long linear_its;      /**< GMRES iterations of the accepted attempt (gmres_ilu) */
 } sp_step_costs;
 
 /** @brief Append one row to energy.csv:
  *  step,t,dt,newton_its,n_cells,energy,bulk,gradient,repulsion,buffer,shape,
  *  seconds,assembly_s,factorisation_s,solves_s,supports_s,support_changed,
  *  unknowns,factorisations,failed_attempts,failed_factorisations,
- *  residual_rise
+ *  residual_rise,linear_its
  *  (@p seconds NULL: zeros) */
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,

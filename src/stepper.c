@@ -479,6 +479,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     sum->newton_its += report.newton_its;
     sum->factorisations += report.factorisations;
     seconds.factorisations = report.factorisations;
+    sum->linear_its += report.linear_its;
+    seconds.linear_its = report.linear_its;
     if (run->scene->solver.predictor == SP_PREDICT_LINEAR) {
       if (!run->state_prev) {
         run->state_prev = malloc(n_values * sizeof(double));

@@ -26,6 +26,7 @@ typedef struct {
   long newton_its;     /**< Newton iterations of accepted steps */
   long factorisations; /**< their factorisations (solver.jacobian_reuse) */
   long failed_factorisations; /**< factorisations of the failed attempts */
+  long linear_its;     /**< GMRES iterations of accepted steps (gmres_ilu) */
   double t_final;      /**< time reached */
   double dt_smallest;  /**< smallest accepted dt */
   double wall_seconds;

@@ -3,7 +3,8 @@
  * touching cells (paper parameters, 3 steps of dt = 1e-4) it takes the
  * same Newton iterations as serial SuperLU and the states agree to 1e-9 of
  * the largest value, at ILU(2) and ILU(4) (the default 1e-10 is tight
- * enough that Newton cannot tell the difference). A tolerance GMRES cannot
+ * enough that Newton cannot tell the difference); the step reports its
+ * GMRES iterations (at least one per Newton iteration; none for SuperLU). A tolerance GMRES cannot
  * reach in its 500 iterations makes the step fail with a reason naming
  * GMRES and leaves the state untouched (the stepper retries with a smaller
  * dt), instead of ending the run. Bad fill or tolerance is refused. */
@@ -35,22 +36,26 @@ int main(int argc, char **argv) {
   sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
   for (int step = 0; step < N_STEPS; ++step) {
     int its[3];
+    long gmres[3];
     for (int s = 0; s < 3; ++s) {
       sp_step_report rep;
       for (int i = 0; i < n; ++i) old[i] = x[s][i];
       CHECK(sp_solver_step(solvers[s], &data, x[s], &rep) == 0, "%s, step %d: %s", names[s], step,
             rep.reason);
       its[s] = rep.newton_its;
+      gmres[s] = rep.linear_its;
     }
+    CHECK(gmres[0] >= its[0] && gmres[1] >= its[1] && gmres[2] == 0,
+          "step %d: GMRES iterations %ld / %ld / %ld", step, gmres[0], gmres[1], gmres[2]);
     double scale = 0, d2 = 0, d4 = 0;
     for (int i = 0; i < n; ++i) {
       scale = fmax(scale, fabs(x[2][i]));
       d2 = fmax(d2, fabs(x[0][i] - x[2][i]));
       d4 = fmax(d4, fabs(x[1][i] - x[2][i]));
     }
-    printf("step %d: Newton iterations %d / %d / %d (ILU(2) / ILU(4) / SuperLU); states against "
-           "SuperLU %.2e / %.2e (of %.3g)\n",
-           step, its[0], its[1], its[2], d2, d4, scale);
+    printf("step %d: Newton iterations %d / %d / %d (ILU(2) / ILU(4) / SuperLU), GMRES iterations "
+           "%ld / %ld; states against SuperLU %.2e / %.2e (of %.3g)\n",
+           step, its[0], its[1], its[2], gmres[0], gmres[1], d2, d4, scale);
     CHECK(its[0] == its[2] && its[1] == its[2], "step %d: Newton iterations %d, %d against %d",
           step, its[0], its[1], its[2]);
     CHECK(d2 <= 1e-9 * scale && d4 <= 1e-9 * scale, "step %d: states differ by %.3e and %.3e",
