@@ -15,8 +15,10 @@
 #include <NOX_StatusTest_NormF.H>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -604,6 +606,9 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   params->sublist("Direction").set("Method", "Newton");
   params->sublist("Direction").sublist("Newton").set("Rescue Bad Newton Solve", false);
   params->sublist("Printing").set("Output Information", 0);
+  // NOX prints its errors before throwing: keep them for the message.
+  auto nox_errors = Teuchos::rcp(new std::ostringstream);
+  params->sublist("Printing").set<Teuchos::RCP<std::ostream>>("Error Stream", nox_errors);
   params->sublist("Solver Options").set("Status Test Check Type", "Complete");
   params->sublist("Solver Options").set<Teuchos::RCP<NOX::Observer>>(
       "User Defined Pre/Post Operator", Teuchos::rcp(new ResidualRecorder(*this)));
@@ -640,11 +645,17 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   last_error.clear();
   // A failed linear solve (applyJacobianInverse false, last_error set):
   // NOX's Newton direction throws; the attempt failed, as a diverging one.
+  // Any other NOX error ends the run with what NOX printed.
   StatusType status = Failed;
   try {
     status = solver->solve();
   } catch (...) {
-    if (last_error.empty()) throw;
+    if (last_error.empty()) {
+      std::string text = nox_errors->str();
+      while (!text.empty() && std::isspace((unsigned char)text.back())) text.pop_back();
+      if (text.empty()) throw;
+      throw std::runtime_error("NOX: " + text);
+    }
   }
   report.newton_its = solver->getNumIterations();
   report.factorisations = step_factorisations_;
