@@ -33,6 +33,9 @@ class KrylovSolver final : public DirectSolver {
       prec_->SetParameters(p);
       if (prec_->Initialize() != 0) {
         why = "ILU: symbolic set-up failed";
+        prec_.reset();
+        rows_.reset();  // the next factor() starts over
+        factored_ = false;
         return false;
       }
       gmres_ = std::make_unique<AztecOO>(&rows_->matrix(), &rows_->lhs(), &rows_->rhs());
