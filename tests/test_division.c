@@ -530,7 +530,37 @@ static void test_equal_mass_line(void) {
   sp_mesh_destroy(&mesh);
 }
 
+/* Which daughter takes the new label follows v1's sign. For a cut along
+ * the vertical (symmetric scenes make them) a round-off-sized Ixy of
+ * either sign must give the same v1; everywhere v1 is the unit
+ * eigenvector of the larger eigenvalue, at an angle in
+ * (0.2 - pi/2, 0.2 + pi/2]. */
+static void test_axis_sign_convention(void) {
+  double I1, I2, v1[2], v2[2], w1[2], w2[2];
+  sp_cells_principal(1.0, 2.0, 1e-17, &I1, &I2, v1, v2);
+  sp_cells_principal(1.0, 2.0, -1e-17, &I1, &I2, w1, w2);
+  printf("vertical axis, Ixy = +-1e-17: v1 = (%.3g, %.3g) and (%.3g, %.3g)\n", v1[0], v1[1],
+         w1[0], w1[1]);
+  CHECK(fabs(v1[0] - w1[0]) < 1e-15 && fabs(v1[1] - w1[1]) < 1e-15 && v1[1] > 0.99,
+        "vertical axis: v1 (%g, %g) against (%g, %g)", v1[0], v1[1], w1[0], w1[1]);
+  double worst = 0;
+  for (int j = 0; j < 360; ++j) {
+    const double phi = M_PI * (j + 0.5) / 180.0 - M_PI; /* the long axis, all ways */
+    const double a = 2.0, b = 1.0, c = cos(phi), s = sin(phi);
+    const double Ixx = a * c * c + b * s * s, Iyy = a * s * s + b * c * c, Ixy = (a - b) * c * s;
+    sp_cells_principal(Ixx, Iyy, Ixy, &I1, &I2, v1, v2);
+    const double angle = atan2(v1[1], v1[0]);
+    const double r0 = Ixx * v1[0] + Ixy * v1[1] - I1 * v1[0];
+    const double r1 = Ixy * v1[0] + Iyy * v1[1] - I1 * v1[1];
+    worst = fmax(worst, hypot(r0, r1));
+    CHECK(angle > 0.2 - M_PI / 2 && angle <= 0.2 + M_PI / 2 + 1e-12,
+          "long axis %g: v1 at %g rad", phi, angle);
+  }
+  CHECK(worst < 1e-14, "eigenvector residual %.3g", worst);
+}
+
 int main(void) {
+  test_axis_sign_convention();
   test_axis_of_ellipses();
   test_split_conserves_and_halves();
   test_split_local_supports();
