@@ -74,7 +74,8 @@ class AmesosSolver final : public DirectSolver {
   bool build(const CsrRows &A, std::string &why) {
     release();
     rows_ = std::make_unique<EpetraRows>(comm_, A);
-    problem_ = std::make_unique<Epetra_LinearProblem>(&rows_->matrix(), &rows_->lhs(), &rows_->rhs());
+    problem_ =
+        std::make_unique<Epetra_LinearProblem>(&rows_->matrix(), &rows_->lhs(), &rows_->rhs());
     Amesos factory;
     solver_.reset(factory.Create(which_, *problem_));
     if (!solver_) throw std::runtime_error("Amesos: could not create " + which_);

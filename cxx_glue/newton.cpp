@@ -238,7 +238,8 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       if (options.ilu_fill != 0) k.fill = options.ilu_fill;
       if (options.krylov_tol != 0) k.tolerance = options.krylov_tol;
       if (k.fill < 0 || !(k.tolerance > 0 && k.tolerance < 1))
-        throw std::runtime_error("solver.ilu_fill / krylov_tol: expected fill >= 0 and 0 < tol < 1");
+        throw std::runtime_error(
+            "solver.ilu_fill / krylov_tol: expected fill >= 0 and 0 < tol < 1");
       direct_ = make_krylov(comm, k);
       break;
     }

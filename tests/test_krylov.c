@@ -4,10 +4,11 @@
  * same Newton iterations as serial SuperLU and the states agree to 1e-9 of
  * the largest value, at ILU(2) and ILU(4) (the default 1e-10 is tight
  * enough that Newton cannot tell the difference); the step reports its
- * GMRES iterations (at least one per Newton iteration; none for SuperLU). A tolerance GMRES cannot
- * reach in its 500 iterations makes the step fail with a reason naming
- * GMRES and leaves the state untouched (the stepper retries with a smaller
- * dt), instead of ending the run. Bad fill or tolerance is refused. */
+ * GMRES iterations (at least one per Newton iteration; none for SuperLU).
+ * A tolerance GMRES cannot reach in its 500 iterations makes the step fail
+ * with a reason naming GMRES and leaves the state untouched (the stepper
+ * retries with a smaller dt), instead of ending the run. Bad fill or
+ * tolerance is refused. */
 #include <string.h>
 
 #include "fixtures.h"
