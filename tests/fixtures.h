@@ -5,6 +5,7 @@
 #include <math.h>
 #include <mpi.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "cells.h"
 #include "check.h"
@@ -41,6 +42,15 @@ static inline sp_solver make_solver_opts(const sp_mesh *mesh, const sp_layout *l
     exit(1);
   }
   return s;
+}
+
+/** sp_solver_create refuses @p opt, with a message naming @p key. */
+static inline void expect_solver_refused(const sp_solver_options *opt, const char *key) {
+  sp_solver s = NULL;
+  CHECK(sp_solver_create(MPI_COMM_WORLD, opt, &s) != 0, "options bad in %s were accepted", key);
+  CHECK(strstr(sp_solver_last_error(s), key) != NULL, "the message does not name %s: %s", key,
+        sp_solver_last_error(s));
+  sp_solver_destroy(&s);
 }
 
 /** A solver with direct solver @p linear (SP_SOLVER_*) on the mesh and layout. */
