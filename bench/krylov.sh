@@ -13,14 +13,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . bench/lib.sh
-steps=${1:-3}
-dt=${2:-2e-5}
-shift 2 || shift $#
-sizes=("$@")
-[ ${#sizes[@]} -eq 0 ] && sizes=(16 64 256)
+packed_args "$@"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-t_end=$(awk -v n="$steps" -v dt="$dt" 'BEGIN { printf "%.17g", n * dt }')
 ratio_line() { # NAME DIR: seconds per step of both runs in DIR, and their ratio
   awk -F, -v name="$1" 'FNR == 1 { f++; next } $1 > 0 { s[f]++; sec[f] += $12 }
     END { a = sec[1] / s[1]; b = sec[2] / s[2]
@@ -31,8 +26,7 @@ for n in "${sizes[@]}"; do
   echo "== $n packed cells, $steps steps of dt = $dt"
   packed_scene "$n" "$tmp/p$n.yaml"
   OUT=$tmp/o$n ab_runs "$tmp/p$n.yaml" superlu_dist solver.linear=superlu_dist \
-    gmres_ilu solver.linear=gmres_ilu --set division.criterion=none --set source.rate=0 \
-    --set time.dt="$dt" --set time.t_end="$t_end" --set output.every=1000000
+    gmres_ilu solver.linear=gmres_ilu "${packed_sets[@]}"
   ratio_line "$n packed cells" "$tmp/o$n"
   echo
 done

@@ -23,6 +23,21 @@ packed_scene() {
   [ "$got" -eq "$n" ] || { echo "only $got lattice sites fit for $n cells" >&2; return 2; }
 }
 
+# packed_args [STEPS] [DT] [N ...]: the arguments of the packed-cell
+# benches. Sets steps and dt (defaults 3 and 2e-5), sizes (default 16 64
+# 256), t_end = steps x dt, and packed_sets, the scene overrides of such a
+# run: no division or source, steps of dt to t_end, no field output.
+packed_args() {
+  steps=${1:-3}
+  dt=${2:-2e-5}
+  shift 2 || shift $#
+  sizes=("$@")
+  [ ${#sizes[@]} -eq 0 ] && sizes=(16 64 256)
+  t_end=$(awk -v n="$steps" -v dt="$dt" 'BEGIN { printf "%.17g", n * dt }')
+  packed_sets=(--set division.criterion=none --set source.rate=0 --set time.dt="$dt"
+               --set time.t_end="$t_end" --set output.every=1000000)
+}
+
 # stage_pictures OUT IMG DIGITS [N ...]: copy the run OUT's energy curve and,
 # for every number of cells N it passed through (or only the Ns listed),
 # its last picture with N cells to IMG/cells_<N>.png, N printed DIGITS wide.

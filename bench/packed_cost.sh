@@ -12,15 +12,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . bench/lib.sh
-steps=${1:-3}
-dt=${2:-2e-5}
-shift 2 || shift $#
-sizes=("$@")
-[ ${#sizes[@]} -eq 0 ] && sizes=(16 64 256)
+packed_args "$@"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 export OMP_NUM_THREADS=1
-t_end=$(awk -v n="$steps" -v dt="$dt" 'BEGIN { printf "%.17g", n * dt }')
 echo "packed cells on inputs/aggregate_256.yaml's mesh: $steps steps of dt = $dt"
 echo
 echo "| cells | unknowns | unknowns / node | Newton its | s/step | s/step/cell | s/iteration | assembly/it | factorisation/it | solves/it | peak MB | per cell vs first |"
@@ -29,8 +24,7 @@ ref=""
 for n in "${sizes[@]}"; do
   packed_scene "$n" "$tmp/p$n.yaml"
   /usr/bin/time -f "%M" -o "$tmp/p$n.mem" build/softpack run "$tmp/p$n.yaml" --out "$tmp/o$n" \
-      --set division.criterion=none --set source.rate=0 --set time.dt="$dt" \
-      --set time.t_end="$t_end" --set output.pictures=false --set output.every=1000000 \
+      "${packed_sets[@]}" --set output.pictures=false \
       > "$tmp/p$n.log" 2>&1 || { echo "$n cells: run failed"; tail -5 "$tmp/p$n.log"; exit 1; }
   nodes=$(grep -o 'NumberOfPoints="[0-9]*"' "$tmp/o$n/fields_000000.vtu" | head -1 | tr -dc 0-9)
   row=$(awk -F, -v n="$n" -v nodes="$nodes" -v mem="$(cat "$tmp/p$n.mem")" -v ref="$ref" \
