@@ -3,7 +3,8 @@
  *   1e-5 relative with a margin of 40 interface widths (measured 7e-7),
  *   1e-3 with 20 widths (measured 5e-4): the cut far field of each field
  *   (its Gibbs-Thomson level) is what differs, not the interface, so the
- *   issue's 1e-8 is not reached (docs/local-support.md); cell masses to
+ *   issue's 1e-8 is not reached with round cells (flat ones, which keep
+ *   no far field, reach it: tests/test_local_exact.c); cell masses to
  *   1e-9 and centres to 1e-7 with 40 widths;
  * - a cell pushed across the mesh keeps its mass to 1e-10 across support
  *   changes (which do happen);
