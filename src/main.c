@@ -67,9 +67,10 @@ static int cmd_run(int argc, char **argv, int rank) {
   if (rc == SP_OK) rc = sp_stepper_run(scene, out_dir, MPI_COMM_WORLD, &sum);
   if (rc == SP_OK && rank == 0 && sum.layout_changes)
     printf("softpack: local supports: %d changes (%.1f s), largest relative mass change restored "
-           "%.2e, largest relative energy rise at a change %.2e, at most %ld unknowns\n",
+           "%.2e, mass dropped in all %.2e of the total, largest relative energy rise at a change "
+           "%.2e, at most %ld unknowns\n",
            sum.layout_changes, sum.t_layout, sum.support_mass_correction,
-           sum.support_energy_rise, sum.unknowns_max);
+           sum.support_mass_dropped, sum.support_energy_rise, sum.unknowns_max);
   else if (rc == SP_OK && rank == 0)
     printf("softpack: at most %ld unknowns per step\n", sum.unknowns_max);
   char gmres[64] = "";

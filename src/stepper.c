@@ -224,12 +224,13 @@ static int adopt_layout(sp_run *run, sp_layout *layout, double *state, double *p
 static int update_supports(sp_run *run, sp_energy_parts *after) {
   const double t0 = wall_clock();
   sp_layout *layout;
-  double *state, correction;
+  double *state, correction, dropped;
   sp_energy_parts before;
   SP_CALL(state_energy(run, &before));
   const int always = run->scene->layout.shrink == SP_SHRINK_ALWAYS;
   SP_CALL(sp_support_rebuild(run->support, run->layout, run->state,
-                             always ? NULL : run->divided_now, &layout, &state, &correction));
+                             always ? NULL : run->divided_now, &layout, &state, &correction,
+                             &dropped));
   memset(run->divided_now, 0, (size_t)run->layout->n_cells);
   double *prev = NULL;
   if (run->prev_valid) { /* the last increment moves with (cell, node), 0 on new pairs */
@@ -250,6 +251,7 @@ static int update_supports(sp_run *run, sp_energy_parts *after) {
                            run->scene->division.observe_threshold, run->obs));
   run->sum->layout_changes += 1;
   if (correction > run->sum->support_mass_correction) run->sum->support_mass_correction = correction;
+  run->sum->support_mass_dropped += dropped;
   const double e_before = field_total(&before);
   const double rise = (field_total(after) - e_before) / fabs(e_before);
   if (rise > run->sum->support_energy_rise) run->sum->support_energy_rise = rise;

@@ -37,6 +37,9 @@ typedef struct {
   double support_mass_correction; /**< largest relative mass change a
                                        support change caused (restored) */
   double t_layout;     /**< seconds spent rebuilding supports */
+  double support_mass_dropped; /**< the mass support changes lost or gained
+                                   in all, relative: sum over the changes of
+                                   |total after - total before| / total */
   double support_energy_rise; /**< largest relative rise of the field
                                    energy at a support change (0 if none
                                    rose) */

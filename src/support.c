@@ -196,11 +196,12 @@ static double buffer_share(sp_support s, int i) {
 
 int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *state,
                        const unsigned char *may_shrink, sp_layout **new_layout,
-                       double **new_state, double *mass_correction) {
+                       double **new_state, double *mass_correction, double *mass_dropped) {
   const int nn = s->mesh->n_nodes, nc = layout->n_cells;
   *new_layout = NULL;
   *new_state = NULL;
   *mass_correction = 0;
+  *mass_dropped = 0;
   unsigned char *mask;
   SP_ALLOC(mask, (size_t)nn * (nc ? nc : 1));
   int rc = sp_support_masks(s, layout, state, mask);
@@ -288,6 +289,17 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
     const int k = to->pair_cell[q];
     if (w_interior[k] <= 0 || next[2 * q] >= SP_SUPPORT_INTERIOR) next[2 * q] += w_all[k];
   }
+  /* The total mass before and after, integral of sum_k c_k = sum over
+   * pairs of (weight x c) on each layout. */
+  double total_after = 0, total_before = 0;
+  for (int q = 0; q < to->n_pairs && rc == SP_OK; ++q) total_after += w[q] * next[2 * q];
+  double *w_old = malloc(sizeof(double) * (size_t)(layout->n_pairs ? layout->n_pairs : 1));
+  if (rc == SP_OK && !w_old) rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
+  if (rc == SP_OK) rc = sp_cells_pair_weights(s->mesh, layout, w_old);
+  for (int p = 0; p < layout->n_pairs && rc == SP_OK; ++p) total_before += w_old[p] * state[2 * p];
+  if (rc == SP_OK)
+    *mass_dropped = fabs(total_after - total_before) / (total_before != 0 ? fabs(total_before) : 1);
+  free(w_old);
   free(acc);
   free(n_edge);
   free(w);

@@ -68,11 +68,14 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout,
  * @param[in] may_shrink n_cells flags (NULL: every cell may shrink)
  * @param[out] mass_correction largest |mass change before correction| /
  *             mass over the cells (what the shift restored)
+ * @param[out] mass_dropped |total mass after - total mass before| / total
+ *             mass before, with the total mass the integral of sum_k c_k
+ *             (what the change lost or gained in the end: round-off)
  */
 int sp_support_rebuild(sp_support s, const sp_layout *layout,
                        const double *state, const unsigned char *may_shrink,
                        sp_layout **new_layout, double **new_state,
-                       double *mass_correction);
+                       double *mass_correction, double *mass_dropped);
 
 /** @brief Layout from per-cell masks, with every cell's mask closed to
  *         whole elements (no node without a whole element of its cell). */

@@ -106,10 +106,12 @@ static void test_rebuild_growth(void) {
   for (int i = 0; i < nn; ++i) mask[nn + i] = 1; /* cell 1 everywhere */
   sp_layout *layout, *grown;
   CHECK_OK(sp_support_layout_from_masks(s_narrow, 2, mask, &layout));
-  double *st = calloc(2 * (size_t)layout->n_pairs, sizeof(double)), *next, correction;
+  double *st = calloc(2 * (size_t)layout->n_pairs, sizeof(double)), *next, correction, dropped;
   sp_layout_transfer(full, state, layout, st, 0.0);
   const unsigned char keep[2] = {0, 0};
-  CHECK_OK(sp_support_rebuild(s_wide, layout, st, keep, &grown, &next, &correction));
+  CHECK_OK(sp_support_rebuild(s_wide, layout, st, keep, &grown, &next, &correction, &dropped));
+  printf("rebuild: total mass dropped %.2e (relative)\n", dropped);
+  CHECK(dropped <= 1e-13, "the rebuild dropped %.3e of the mass", dropped);
   sp_cell_obs before[2], after[2];
   CHECK_OK(sp_cells_observe(mesh, layout, st, 0.0, before));
   CHECK_OK(sp_cells_observe(mesh, grown, next, 0.0, after));
@@ -220,8 +222,11 @@ int main(int argc, char **argv) {
   cells_at_step("local_push/cells.csv", 0, 2, m0, x0, y0);
   cells_at_step("local_push/cells.csv", -1, 2, m1, x1, y1);
   printf("pushed cell: x %.4f -> %.4f, %d support changes, mass %.15g -> %.15g; largest mass "
-         "change restored %.2e, largest energy rise at a change %.2e\n", x0[1], x1[1],
-         p.layout_changes, m0[1], m1[1], p.support_mass_correction, p.support_energy_rise);
+         "change restored %.2e, mass dropped in all %.2e, largest energy rise at a change %.2e\n",
+         x0[1], x1[1], p.layout_changes, m0[1], m1[1], p.support_mass_correction,
+         p.support_mass_dropped, p.support_energy_rise);
+  CHECK(p.support_mass_dropped <= 1e-10, "support changes dropped %.3e of the mass in all",
+        p.support_mass_dropped);
   CHECK(p.layout_changes >= 1, "the supports never changed");
   CHECK(x1[1] - x0[1] > 0.01, "the small cell did not move: %g -> %g", x0[1], x1[1]);
   for (int k = 0; k < 2; ++k)
@@ -242,9 +247,11 @@ int main(int argc, char **argv) {
   sp_run_summary d;
   CHECK_OK(sp_stepper_run(scene, "local_divide", MPI_COMM_WORLD, &d));
   printf("division, local supports: %d cells, %d divisions, %d support changes, max %ld unknowns; "
-         "largest mass change restored %.2e, largest energy rise at a change %.2e\n",
-         d.n_cells, d.divisions, d.layout_changes, d.unknowns_max, d.support_mass_correction,
-         d.support_energy_rise);
+         "largest mass change restored %.2e, mass dropped in all %.2e, largest energy rise at a "
+         "change %.2e\n", d.n_cells, d.divisions, d.layout_changes, d.unknowns_max,
+         d.support_mass_correction, d.support_mass_dropped, d.support_energy_rise);
+  CHECK(d.support_mass_dropped <= 1e-10, "support changes dropped %.3e of the mass in all",
+        d.support_mass_dropped);
   CHECK(d.n_cells == 4 && d.divisions == 3, "%d cells, %d divisions", d.n_cells, d.divisions);
   double md[4], xd[4], yd[4];
   cells_at_step("local_divide/cells.csv", -1, 4, md, xd, yd);
