@@ -7,7 +7,8 @@
  *   no far field, reach it: tests/test_local_exact.c); cell masses to
  *   1e-9 and centres to 1e-7 with 40 widths;
  * - a cell pushed across the mesh keeps its mass to 1e-10 across support
- *   changes (which do happen);
+ *   changes (which do happen), and the mass the changes drop in all (the
+ *   run's total, like the division run's below) stays below 1e-10;
  * - supports reaching the domain boundary and the buffer ring behave;
  * - after a division the children's supports cover the children. */
 #include <string.h>
