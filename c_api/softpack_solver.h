@@ -64,6 +64,9 @@ typedef struct {
    *  spending the rest of newton_max_its). 0: off; otherwise > 1. */
   double newton_divergence;
   int ordering;  /**< SP_SOLVER_ORDER_* (SuperLU_DIST only); 0: pairs */
+  /** SuperLU_DIST only: 1 for one step of iterative refinement per solve
+   *  (SuperLU_DIST's default), 0 for none. */
+  int refine;
   /** SP_SOLVER_GMRES_ILU only: the ILU(k) level of fill (0 = 2) and the
    *  relative residual of a linear solve (0 = 1e-10). */
   int ilu_fill;

@@ -65,8 +65,9 @@ std::unique_ptr<DirectSolver> make_superlu();
 std::unique_ptr<DirectSolver> make_gathered(MPI_Comm comm, std::unique_ptr<DirectSolver> serial);
 // SuperLU_DIST (pdgssvx, SLU_NR_loc rows as they are distributed).
 // pair_order: METIS on the (cell, node) pair graph (rows in (c, mu) pairs),
-// else SuperLU_DIST's METIS on the unknowns.
-std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order);
+// else SuperLU_DIST's METIS on the unknowns. refine: one step of iterative
+// refinement per solve.
+std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, bool refine);
 // Amesos (v1) on an Epetra copy of the rows: which = "Amesos_Mumps" or
 // "Amesos_Klu". Throws if Amesos was built without it.
 std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &which);

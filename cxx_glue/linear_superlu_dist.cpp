@@ -27,7 +27,7 @@ namespace {
 
 class SuperLUDist final : public DirectSolver {
  public:
-  SuperLUDist(MPI_Comm comm, bool pair_order) : pair_order_(pair_order) {
+  SuperLUDist(MPI_Comm comm, bool pair_order, bool refine) : pair_order_(pair_order) {
     int P = 1;
     MPI_Comm_size(comm, &P);
     // The squarest grid with nprow <= npcol (SuperLU_DIST prefers wide grids).
@@ -36,10 +36,13 @@ class SuperLUDist final : public DirectSolver {
     superlu_gridinit(comm, nprow, P / nprow, &grid_);
     set_default_options_dist(&options_);
     options_.PrintStat = NO;
-    // Defaults kept: Equil = YES, RowPerm = LargeDiag_MC64, IterRefine =
-    // SLU_DOUBLE (one refinement step makes the solves as accurate as
-    // SuperLU's partial pivoting here). ColPerm: METIS on the pair graph
-    // (pair_ordering), given as MY_PERMC, or METIS_AT_PLUS_A.
+    // Defaults kept: Equil = YES, RowPerm = LargeDiag_MC64. ColPerm: METIS
+    // on the pair graph (pair_ordering), given as MY_PERMC, or
+    // METIS_AT_PLUS_A. IterRefine: SuperLU_DIST's default, one step of
+    // iterative refinement per solve (SLU_DOUBLE), only with refine; its
+    // residual and second triangular solve cost 2/3 of a solve and change
+    // nothing Newton sees here (docs/parallel.md).
+    options_.IterRefine = refine ? SLU_DOUBLE : NOREFINE;
   }
   ~SuperLUDist() override {
     release();
@@ -250,8 +253,8 @@ static_assert(sizeof(int_t) == sizeof(int), "SuperLU_DIST built with 64-bit indi
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order) {
-  return std::make_unique<SuperLUDist>(comm, pair_order);
+std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, bool refine) {
+  return std::make_unique<SuperLUDist>(comm, pair_order, refine);
 }
 
 }  // namespace sp

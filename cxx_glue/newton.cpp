@@ -221,7 +221,8 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
                        : make_gathered(comm, comm_.MyPID() == 0 ? make_superlu() : nullptr);
       break;
     case SP_SOLVER_SUPERLU_DIST:
-      direct_ = make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS);
+      direct_ = make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS,
+                                  options.refine != 0);
       break;
     case SP_SOLVER_MUMPS: direct_ = make_amesos(comm, "Amesos_Mumps"); break;
     case SP_SOLVER_KLU2:

@@ -93,6 +93,7 @@ typedef struct {
                                  (0: off) */
   sp_predictor_kind predictor; /**< Newton's initial guess */
   sp_ordering_kind ordering;   /**< SuperLU_DIST's column order */
+  int refine;                  /**< SuperLU_DIST: iterative refinement */
 } sp_scene_solver;
 
 /** output: what is written and when. */

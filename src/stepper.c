@@ -40,6 +40,7 @@ void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt)
   opt->newton_divergence = scene->solver.newton_divergence;
   opt->ordering = scene->solver.ordering == SP_ORDER_PAIRS ? SP_SOLVER_ORDER_PAIRS
                                                            : SP_SOLVER_ORDER_UNKNOWNS;
+  opt->refine = scene->solver.refine;
 }
 
 void sp_model_from_scene(const sp_scene *scene, sp_model_params *model) {
