@@ -8,8 +8,8 @@
 # seconds per Newton iteration and its phases, and the per-cell cost
 # against the 16-cell stage. Copies the last pictures with 16, 64, 128
 # and 256 cells and the energy curve to docs/img/aggregate_256/. Under NP=2 on a
-# 2-core machine the run reaches 256 cells in about 16 minutes and its t_end in
-# about 39 (about 5 GB);
+# 2-core machine the run reaches 256 cells in about 10 minutes and its t_end in
+# about 23 (2.6 GB on rank 0);
 # the table comes from what energy.csv holds, so a run stopped early can
 # be tabled with --reuse (docs/local-support.md, "Scale").
 #   bench/aggregate.sh [--reuse] [--set key=value ...]
