@@ -133,11 +133,7 @@ int main(int argc, char **argv) {
           worst_out = fmax(worst_out, dc);
         }
       }
-    sp_energy_parts ef, el;
-    CHECK_OK(sp_solver_energy(sf, &model, xf, &ef));
-    CHECK_OK(sp_solver_energy(sl, &model, xl, &el));
-    const double Ef = ef.bulk + ef.gradient + ef.repulsion + ef.buffer,
-                 El = el.bulk + el.gradient + el.repulsion + el.buffer;
+    const double Ef = energy_total(sf, &model, xf), El = energy_total(sl, &model, xl);
     worst_e = fmax(worst_e, fabs(El - Ef) / fabs(Ef));
     if (step == 0 || step == N_STEPS - 1)
       printf("step %d: Newton %d / %d, energy %.12g (full) %.12g (local)\n", step,
