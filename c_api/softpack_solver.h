@@ -45,6 +45,10 @@ enum {
  *  (cell, node) pairs (c and mu of a pair together), or on the unknowns
  *  (SuperLU_DIST's own METIS_AT_PLUS_A). */
 enum { SP_SOLVER_ORDER_PAIRS = 0, SP_SOLVER_ORDER_UNKNOWNS = 1 };
+/** The length of each Newton update: the full step, or NOX's backtracking
+ *  line search (halve the step until ||F|| falls, down to 1e-12 of it;
+ *  failing that, the full step). */
+enum { SP_SOLVER_STEP_FULL = 0, SP_SOLVER_STEP_BACKTRACK = 1 };
 
 typedef struct sp_solver_s *sp_solver;
 
@@ -63,6 +67,7 @@ typedef struct {
    *  of the step's first ||F_0|| (it is retried with a smaller dt without
    *  spending the rest of newton_max_its). 0: off; otherwise > 1. */
   double newton_divergence;
+  int line_search; /**< SP_SOLVER_STEP_*; 0: full steps */
   int ordering;  /**< SP_SOLVER_ORDER_* (SuperLU_DIST only); 0: pairs */
   /** SuperLU_DIST only: 1 for one step of iterative refinement per solve
    *  (SuperLU_DIST's default), 0 for none. */

@@ -211,6 +211,8 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     throw std::runtime_error("solver.jacobian_reuse: expected 0 <= value < 1");
   if (options.ordering != SP_SOLVER_ORDER_PAIRS && options.ordering != SP_SOLVER_ORDER_UNKNOWNS)
     throw std::runtime_error("solver.ordering: unknown kind");
+  if (options.line_search != SP_SOLVER_STEP_FULL && options.line_search != SP_SOLVER_STEP_BACKTRACK)
+    throw std::runtime_error("solver.line_search: unknown kind");
   if (!(options.newton_divergence == 0 || options.newton_divergence > 1))
     throw std::runtime_error("solver.newton_divergence: expected 0 (off) or a value > 1");
   const int P = comm_.NumProc();
@@ -604,7 +606,18 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *iface));
   auto params = Teuchos::rcp(new Teuchos::ParameterList);
   params->set("Nonlinear Solver", "Line Search Based");
-  params->sublist("Line Search").set("Method", "Full Step");
+  // Backtrack: NOX's defaults (halve the step until the sum of squares of
+  // F falls, down to 1e-12, else the full step), spelled out.
+  Teuchos::ParameterList &search = params->sublist("Line Search");
+  if (options_.line_search == SP_SOLVER_STEP_BACKTRACK) {
+    search.set("Method", "Backtrack");
+    search.sublist("Backtrack").set("Default Step", 1.0);
+    search.sublist("Backtrack").set("Reduction Factor", 0.5);
+    search.sublist("Backtrack").set("Minimum Step", 1e-12);
+    search.sublist("Backtrack").set("Max Iters", 100);
+  } else {
+    search.set("Method", "Full Step");
+  }
   params->sublist("Direction").set("Method", "Newton");
   params->sublist("Direction").sublist("Newton").set("Rescue Bad Newton Solve", false);
   params->sublist("Printing").set("Output Information", 0);

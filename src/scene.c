@@ -133,6 +133,8 @@ static const cyaml_strval_t sp_ordering_words[] = {
     {"pairs", SP_ORDER_PAIRS}, {"unknowns", SP_ORDER_UNKNOWNS}};
 static const cyaml_strval_t sp_predictor_words[] = {
     {"none", SP_PREDICT_NONE}, {"linear", SP_PREDICT_LINEAR}};
+static const cyaml_strval_t sp_line_search_words[] = {
+    {"full", SP_STEP_FULL}, {"backtrack", SP_STEP_BACKTRACK}};
 static const cyaml_strval_t sp_division_words[] = {
     {"none", SP_DIVIDE_NONE}, {"age", SP_DIVIDE_BY_AGE}, {"mass", SP_DIVIDE_BY_MASS}};
 static const cyaml_strval_t sp_cut_words[] = {
@@ -303,6 +305,13 @@ static const sp_key sp_keys[] = {
               "a step fails (and is retried with a smaller dt) as soon as an "
               "iteration's residual norm exceeds this multiple of the step's "
               "first one (0: off; otherwise > 1)"),
+    KEY_ENUM(SP_SEC_SOLVER, "line_search", solver.line_search, SP_STEP_FULL,
+             sp_line_search_words, "-",
+             "the length of each Newton update: the full step (as in the "
+             "paper) or NOX's backtracking line search, which halves it "
+             "until the residual norm falls (down to 1e-12 of it, then the "
+             "full step): fewer failed attempts and larger steps in packed "
+             "aggregates"),
     KEY_ENUM(SP_SEC_SOLVER, "ordering", solver.ordering, SP_ORDER_PAIRS,
              sp_ordering_words, "-",
              "superlu_dist's fill-reducing order: METIS on the graph of the "

@@ -41,6 +41,8 @@ void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt)
   opt->ordering = scene->solver.ordering == SP_ORDER_PAIRS ? SP_SOLVER_ORDER_PAIRS
                                                            : SP_SOLVER_ORDER_UNKNOWNS;
   opt->refine = scene->solver.refine;
+  opt->line_search = scene->solver.line_search == SP_STEP_BACKTRACK ? SP_SOLVER_STEP_BACKTRACK
+                                                                    : SP_SOLVER_STEP_FULL;
 }
 
 void sp_model_from_scene(const sp_scene *scene, sp_model_params *model) {
