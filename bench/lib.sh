@@ -102,12 +102,17 @@ ab_runs() {
   local bin=${SOFTPACK:-build/softpack} out=${OUT:-$(mktemp -d)} launch=()
   [ "${NP:-1}" -gt 1 ] && launch=(mpirun --allow-run-as-root -np "$NP")
   export OMP_NUM_THREADS=1
+  local wall=()
+  mkdir -p "$out"
   for i in 0 1; do
     run=${names[$i]}
     /usr/bin/time -f "$run: %e s wall, %M kB peak (rank 0)" "${launch[@]}" "$bin" run "$scene" \
         --out "$out/$run" --set "${sets[$i]}" --set output.pictures=false "$@" 2>&1 |
-      grep -v "^softpack: step\|^  " | sed "s/^/$run: /"
+      grep -v "^softpack: step\|^  " | sed "s/^/$run: /" | tee "$out/$run.summary"
+    wall[$i]=$(sed -n "s/^$run: $run: \([0-9.]*\) s wall.*/\1/p" "$out/$run.summary")
   done
+  awk -v a="${wall[0]}" -v b="${wall[1]}" -v na="${names[0]}" -v nb="${names[1]}" \
+    'BEGIN { if (a > 0 && b > 0) printf "wall time %s / %s: %.2f\n", na, nb, a / b }'
   echo "per accepted step (energy.csv): Newton iterations, factorisations, failed attempts, seconds"
   for run in "${names[@]}"; do
     awk -F, -v run="$run" 'NR > 1 && $1 > 0 { s++; it += $4; f += $19; fa += $20; sec += $12; fs += $14 }
