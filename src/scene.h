@@ -20,6 +20,7 @@ typedef enum { SP_PROFILE_TANH = 0, SP_PROFILE_SHARP = 1 } sp_profile_kind;
 typedef enum { SP_JAC_AD = 0, SP_JAC_HAND = 1, SP_JAC_FD = 2 } sp_jacobian_kind;
 /** Newton's initial guess: the last state, or extrapolated from the last two. */
 typedef enum { SP_PREDICT_NONE = 0, SP_PREDICT_LINEAR = 1 } sp_predictor_kind;
+/** The length of a Newton update: the full step, or NOX's backtracking line search. */
 typedef enum { SP_STEP_FULL = 0, SP_STEP_BACKTRACK = 1 } sp_line_search_kind;
 /** SuperLU_DIST's column order: METIS on the (cell, node) pairs or on the unknowns. */
 typedef enum { SP_ORDER_PAIRS = 0, SP_ORDER_UNKNOWNS = 1 } sp_ordering_kind;

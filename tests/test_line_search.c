@@ -92,7 +92,8 @@ int main(int argc, char **argv) {
   printf("dt = %.1e: full steps rc %d after %d iterations, largest |F| ", dt, rc_full,
          rep_full.newton_its);
   double largest = 0;
-  for (int i = 0; i < rep_full.n_residuals; ++i) largest = fmax(largest, rep_full.residual_norms[i]);
+  for (int i = 0; i < rep_full.n_residuals; ++i)
+    largest = fmax(largest, rep_full.residual_norms[i]);
   printf("%.3g; line search rc %d after %d iterations, |F|:", largest, rc_back,
          rep_back.newton_its);
   for (int i = 0; i < rep_back.n_residuals; ++i) printf(" %.2e", rep_back.residual_norms[i]);
