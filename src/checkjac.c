@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "cells.h"
+#include "dt_control.h"
 #include "error.h"
 #include "layout.h"
 #include "mesh.h"
@@ -85,14 +86,18 @@ static int check_state(checkjac *c, const char *what, double t, double *worst_ha
   return SP_OK;
 }
 
-/** K backward-Euler steps at the scene's dt, shrinking dt by time.shrink
- *  after a failed Newton solve (never accepting it), as the stepper does. */
+/** K backward-Euler steps under the run's time-step controller
+ *  (dt_control.h: the scene's time.control; no error estimate here, so an
+ *  adaptive controller holds its first dt), never accepting a failed
+ *  Newton solve. */
 static int take_steps(checkjac *c, int steps, double *t, double *dt_last, int *retries) {
-  const sp_scene_time *tc = &c->scene->time;
   const size_t n_values = 2 * (size_t)c->layout->n_pairs;
-  double dt = tc->dt;
-  int failures = 0;
+  sp_dt_params p;
+  sp_dt_params_from_scene(c->scene, &p);
+  sp_dt_control dtc;
+  sp_dt_init(&dtc, &p, c->scene->time.dt);
   for (int step = 0; step < steps;) {
+    const double dt = sp_dt_propose(&dtc, *t, INFINITY, NULL);
     memcpy(c->state_old, c->state, n_values * sizeof(double));
     sp_step_data data = {.dt = dt, .model = c->model, .state_old = c->state_old,
                          .source = NULL, .shape = NULL};
@@ -104,13 +109,12 @@ static int take_steps(checkjac *c, int steps, double *t, double *dt_last, int *r
     if (rc == 1) {
       memcpy(c->state, c->state_old, n_values * sizeof(double));
       ++*retries;
-      dt *= tc->shrink;
-      if (++failures > tc->max_retries || dt < tc->dt_min)
+      if (sp_dt_newton_failed(&dtc, dt))
         return sp_error_set(SP_ERR_SOLVER, "Newton failed on step %d at t = %.6g: %s",
                             step + 1, *t, report.reason);
       continue;
     }
-    failures = 0;
+    sp_dt_accepted(&dtc, dt, -1.0);
     *dt_last = dt;
     *t += dt;
     ++step;

@@ -220,7 +220,7 @@ int sp_output_open(const char *dir, sp_output *out) {
                      "step,t,dt,newton_its,n_cells,energy,bulk,gradient,"
                      "repulsion,buffer,shape,seconds,assembly_s,factorisation_s,solves_s,"
                      "supports_s,support_changed,unknowns,factorisations,failed_attempts,"
-                     "failed_factorisations,residual_rise,linear_its",
+                     "failed_factorisations,residual_rise,linear_its,error_estimate",
                      &o->energy);
   if (rc == SP_OK)
     rc = sp_log_open(o->cells_path, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass,area",
@@ -242,17 +242,18 @@ int sp_output_energy(sp_output out, int step, double t, double dt,
                      double shape, const sp_step_costs *seconds) {
   sp_energy_parts p = {0, 0, 0, 0};
   if (parts) p = *parts;
-  sp_step_costs w = {0};
+  sp_step_costs w = {.error_estimate = -1};
   if (seconds) w = *seconds;
   double total = p.bulk + p.gradient + p.repulsion + p.buffer + shape;
   /* %.17g: every double prints to a string that reads back bit-exact. */
   int n = fprintf(out->energy,
                   "%d,%.17g,%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
-                  "%.4g,%.4g,%.4g,%.4g,%.4g,%d,%ld,%d,%d,%d,%.4g,%ld\n",
+                  "%.4g,%.4g,%.4g,%.4g,%.4g,%d,%ld,%d,%d,%d,%.4g,%ld,%.6g\n",
                   step, t, dt, newton_its, n_cells, total, p.bulk, p.gradient,
                   p.repulsion, p.buffer, shape, w.step, w.assembly, w.factorisation,
                   w.solves, w.supports, w.support_changed, w.unknowns, w.factorisations,
-                  w.failed_attempts, w.failed_factorisations, w.residual_rise, w.linear_its);
+                  w.failed_attempts, w.failed_factorisations, w.residual_rise, w.linear_its,
+                  w.error_estimate);
   return sp_log_done(out->energy, out->energy_path, n);
 }
 

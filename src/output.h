@@ -39,14 +39,17 @@ typedef struct {
   int factorisations, failed_attempts, failed_factorisations;
   double residual_rise; /**< largest ||F_k|| / ||F_0|| of the accepted attempt */
   long linear_its;      /**< GMRES iterations of the accepted attempt (gmres_ilu) */
+  double error_estimate; /**< time.control adaptive: the step's local error
+                              estimate over its tolerance (<= 1: accepted;
+                              -1: no estimate, e.g. a first step) */
 } sp_step_costs;
 
 /** @brief Append one row to energy.csv:
  *  step,t,dt,newton_its,n_cells,energy,bulk,gradient,repulsion,buffer,shape,
  *  seconds,assembly_s,factorisation_s,solves_s,supports_s,support_changed,
  *  unknowns,factorisations,failed_attempts,failed_factorisations,
- *  residual_rise,linear_its
- *  (@p seconds NULL: zeros) */
+ *  residual_rise,linear_its,error_estimate
+ *  (@p seconds NULL: zeros, error_estimate -1) */
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,
                      double shape, const sp_step_costs *seconds);

@@ -131,6 +131,10 @@ static const cyaml_strval_t sp_linear_words[] = {
     {"gmres_ilu", SP_LINEAR_GMRES_ILU}};
 static const cyaml_strval_t sp_ordering_words[] = {
     {"pairs", SP_ORDER_PAIRS}, {"unknowns", SP_ORDER_UNKNOWNS}};
+static const cyaml_strval_t sp_control_words[] = {
+    {"fixed", SP_CONTROL_FIXED}, {"adaptive", SP_CONTROL_ADAPTIVE}};
+static const cyaml_strval_t sp_time_scheme_words[] = {
+    {"be", SP_TIME_BE}, {"bdf2", SP_TIME_BDF2}};
 static const cyaml_strval_t sp_predictor_words[] = {
     {"none", SP_PREDICT_NONE}, {"linear", SP_PREDICT_LINEAR}};
 static const cyaml_strval_t sp_line_search_words[] = {
@@ -241,6 +245,23 @@ static const sp_key sp_keys[] = {
     KEY_FLOAT(SP_SEC_MODEL, "mobility", model.mobility, 1.0, ABOVE(0.0),
               UNBOUNDED, "L^2/(E T)", "Cahn-Hilliard mobility M"),
     /* time */
+    KEY_ENUM(SP_SEC_TIME, "control", time.control, SP_CONTROL_FIXED,
+             sp_control_words, "-",
+             "how dt is chosen: fixed (the paper's: dt, shrunk after a failed "
+             "Newton solve, algorithm 2 after a division) or adaptive (from a "
+             "local error estimate of c against rtol and atol; "
+             "docs/time-stepping.md)"),
+    KEY_ENUM(SP_SEC_TIME, "scheme", time.scheme, SP_TIME_BE,
+             sp_time_scheme_words, "-",
+             "time scheme: backward Euler (be, the paper's) or variable-step "
+             "BDF2 (bdf2, second order; BE after the start and each "
+             "division)"),
+    KEY_FLOAT(SP_SEC_TIME, "rtol", time.rtol, 1e-3, ABOVE(0.0), UNBOUNDED, "-",
+              "adaptive: relative tolerance of a step's local error in c"),
+    KEY_FLOAT(SP_SEC_TIME, "atol", time.atol, 1e-3, ABOVE(0.0), UNBOUNDED, "-",
+              "adaptive: absolute tolerance of a step's local error in c"),
+    KEY_FLOAT(SP_SEC_TIME, "dt_max", time.dt_max, 1.0, ABOVE(0.0), UNBOUNDED,
+              "T", "adaptive: the largest step (must be >= dt_min)"),
     KEY_FLOAT(SP_SEC_TIME, "dt", time.dt, 2e-4, ABOVE(0.0), UNBOUNDED, "T",
               "base time step dt_bar (backward Euler)"),
     KEY_FLOAT(SP_SEC_TIME, "t_end", time.t_end, 0.02, ABOVE(0.0), UNBOUNDED,
@@ -344,6 +365,10 @@ static const sp_key sp_keys[] = {
              "write PNG pictures"),
     KEY_INT(SP_SEC_OUTPUT, "picture_width", output.picture_width, 800,
             AT_LEAST(64), AT_MOST(8192), "px", "picture width"),
+    KEY_FLOAT(SP_SEC_OUTPUT, "interval", output.interval, 0.0, AT_LEAST(0.0),
+              UNBOUNDED, "T",
+              "also write fields and pictures at every multiple of this time "
+              "(steps land on them; 0: off)"),
     /* division */
     KEY_ENUM(SP_SEC_DIVISION, "criterion", division.criterion, SP_DIVIDE_NONE,
              sp_division_words, "-",
@@ -1105,6 +1130,9 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
            "%s: time.dt_min: expected a number <= time.dt = %.15g, got "
            "%.15g",
            file, t->dt, t->dt_min);
+  SP_CHECK(t->dt_max >= t->dt_min, SP_ERR_INPUT,
+           "%s: time.dt_max: expected a number >= time.dt_min = %.15g, got %.15g", file,
+           t->dt_min, t->dt_max);
   SP_CHECK(scene->solver.newton_divergence == 0 || scene->solver.newton_divergence > 1,
            SP_ERR_INPUT,
            "%s: solver.newton_divergence: expected 0 (off) or a number > 1, got %.15g",

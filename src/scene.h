@@ -52,8 +52,17 @@ typedef struct {
   double mobility; /**< M */
 } sp_scene_model;
 
-/** time: backward Euler steps and their control. */
+/** How dt is chosen (src/dt_control.h). */
+typedef enum { SP_CONTROL_FIXED = 0, SP_CONTROL_ADAPTIVE = 1 } sp_control_kind;
+/** What a step solves (src/time_scheme.h). */
+typedef enum { SP_TIME_BE = 0, SP_TIME_BDF2 = 1 } sp_time_scheme_kind;
+
+/** time: the time scheme and its step control. */
 typedef struct {
+  sp_control_kind control;    /**< fixed (the paper's) | adaptive */
+  sp_time_scheme_kind scheme; /**< be (the paper's) | bdf2 */
+  double rtol, atol;  /**< adaptive: local error tolerances on c */
+  double dt_max;      /**< adaptive: the largest step */
   double dt;        /**< the scene's (base) step dt_bar */
   double t_end;     /**< final time */
   int max_steps;    /**< stop after this many accepted steps */
@@ -104,6 +113,8 @@ typedef struct {
   int every;          /**< fields and pictures every this many steps */
   int pictures;       /**< 1: write PNG pictures */
   int picture_width;  /**< picture width in pixels */
+  double interval;    /**< also write at multiples of this time (0: off);
+                           steps land on those times */
 } sp_scene_output;
 
 typedef enum {

@@ -8,6 +8,7 @@
 
 #include "cells.h"
 #include "division.h"
+#include "dt_control.h"
 #include "error.h"
 #include "layout.h"
 #include "output.h"
@@ -16,6 +17,7 @@
 #include "shape.h"
 #include "source.h"
 #include "support.h"
+#include "time_scheme.h"
 
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
   const sp_scene_mesh *m = &scene->mesh;
@@ -89,13 +91,13 @@ typedef struct {
   sp_solver solver;
   sp_output output;
   sp_model_params model;
-  double *state, *state_old;
-  /* solver.predictor linear: the state before the last accepted step (on
-   * the current layout) and that step's dt; valid from the second step on
-   * and not across a division */
-  double *state_prev;
-  double dt_prev;
-  int prev_valid;
+  double *state, *state_old; /* the state, and c^n of the step in progress */
+  double *state_eff;  /* the step's backward-Euler form of c^n (BDF2: c_hat) */
+  double *scratch;    /* the error estimate's extrapolation */
+  /* the past states (time scheme, error estimate, solver.predictor) on the
+   * current layout; emptied by a division */
+  sp_history hist;
+  sp_dt_control dtc;  /* how dt is chosen: dt_control.h */
   sp_cell_obs *obs;
   double *energy_t, *energy_total; /* the energy history for energy.png */
   int n_energy, cap_energy;
@@ -204,19 +206,19 @@ static int grow_array(void **ptr, size_t elem, int n_old, int n) {
 }
 
 /** Make (layout, state) the run's own, resize the per-pair buffers and
- *  hand the layout to the solver. @p prev: the predictor's previous state
- *  on @p layout (taken over), or NULL: the predictor starts over. */
-static int adopt_layout(sp_run *run, sp_layout *layout, double *state, double *prev) {
+ *  hand the layout to the solver (the history is the caller's to move). */
+static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
   sp_layout_destroy(&run->layout);
   free(run->state);
   free(run->state_old);
+  free(run->state_eff);
+  free(run->scratch);
   free(run->source);
-  free(run->state_prev);
   run->layout = layout;
   run->state = state;
-  run->state_prev = prev;
-  run->prev_valid = prev != NULL;
   SP_ALLOC(run->state_old, 2 * (size_t)layout->n_pairs);
+  SP_ALLOC(run->state_eff, 2 * (size_t)layout->n_pairs);
+  SP_ALLOC(run->scratch, 2 * (size_t)layout->n_pairs);
   SP_ALLOC(run->source, layout->n_pairs);
   return sp_solver_attach(run->solver, run->mesh, run->layout);
 }
@@ -235,20 +237,14 @@ static int update_supports(sp_run *run, sp_energy_parts *after) {
                              always ? NULL : run->divided_now, &layout, &state, &correction,
                              &dropped));
   memset(run->divided_now, 0, (size_t)run->layout->n_cells);
-  double *prev = NULL;
-  if (run->prev_valid) { /* the last increment moves with (cell, node), 0 on new pairs */
-    const size_t n_old = 2 * (size_t)run->layout->n_pairs, n_new = 2 * (size_t)layout->n_pairs;
-    for (size_t i = 0; i < n_old; ++i) run->state_prev[i] = run->state[i] - run->state_prev[i];
-    prev = malloc(n_new * sizeof(double));
-    if (!prev) {
-      sp_layout_destroy(&layout);
-      free(state);
-      return sp_error_set(SP_ERR_MEMORY, "out of memory");
-    }
-    sp_layout_transfer(run->layout, run->state_prev, layout, prev, 0.0);
-    for (size_t i = 0; i < n_new; ++i) prev[i] = state[i] - prev[i];
+  /* the past states move with (cell, node) as increments, 0 on new pairs */
+  int rc = sp_history_transfer(&run->hist, run->mesh, run->layout, run->state, layout, state);
+  if (rc != SP_OK) {
+    sp_layout_destroy(&layout);
+    free(state);
+    return rc;
   }
-  SP_CALL(adopt_layout(run, layout, state, prev));
+  SP_CALL(adopt_layout(run, layout, state));
   SP_CALL(state_energy(run, after));
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            run->scene->division.observe_threshold, run->obs));
@@ -288,10 +284,7 @@ static int divide_cell(sp_run *run, int parent, double t, int step) {
   SP_CALL(layout_with_child(run, parent, &new_layout));
   const size_t n_values = 2 * (size_t)new_layout->n_pairs;
   double *new_state = calloc(n_values, sizeof(double));
-  double *new_old = calloc(n_values, sizeof(double));
-  double *new_source = calloc((size_t)new_layout->n_pairs, sizeof(double));
-  if (!new_state || !new_old || !new_source) {
-    free(new_state); free(new_old); free(new_source);
+  if (!new_state) {
     sp_layout_destroy(&new_layout);
     return sp_error_set(SP_ERR_MEMORY, "out of memory dividing cell %d", parent + 1);
   }
@@ -307,18 +300,12 @@ static int divide_cell(sp_run *run, int parent, double t, int step) {
     rc = sp_division_split(run->mesh, run->layout, run->state, parent, &parent_obs, smooth,
                            width, offset, new_layout, new_state, child);
   if (rc != SP_OK) {
-    free(new_state); free(new_old); free(new_source);
+    free(new_state);
     sp_layout_destroy(&new_layout);
     return rc;
   }
-  sp_layout_destroy(&run->layout);
-  free(run->state); free(run->state_old); free(run->source); free(run->state_prev);
-  run->state_prev = NULL; /* the predictor starts over after a division */
-  run->prev_valid = 0;
-  run->layout = new_layout;
-  run->state = new_state;
-  run->state_old = new_old;
-  run->source = new_source;
+  sp_history_reset(&run->hist); /* the scheme starts over after a division */
+  SP_CALL(adopt_layout(run, new_layout, new_state));
   SP_CALL(grow_array((void **)&run->obs, sizeof *run->obs, n, n + 1));
   SP_CALL(grow_array((void **)&run->birth, sizeof *run->birth, n, n + 1));
   SP_CALL(grow_array((void **)&run->source_on, sizeof *run->source_on, n, n + 1));
@@ -333,7 +320,6 @@ static int divide_cell(sp_run *run, int parent, double t, int step) {
   core_view(run->obs, n + 1, core);
   sp_division_record_births(t, core, parent, child, run->birth);
   free(core);
-  SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   double px, py, dx, dy;
   sp_division_axis(&parent_obs, &px, &py, &dx, &dy);
   double angle = atan2(dy, dx);
@@ -372,63 +358,143 @@ static int divide_due_cells(sp_run *run, double t_old, double t, int step,
   return SP_OK;
 }
 
+void sp_dt_params_from_scene(const sp_scene *scene, sp_dt_params *p) {
+  const sp_scene_time *tc = &scene->time;
+  *p = (sp_dt_params){
+      .policy = tc->control == SP_CONTROL_ADAPTIVE ? SP_DT_ADAPTIVE : SP_DT_FIXED,
+      .dt = tc->dt, .dt_min = tc->dt_min, .dt_max = tc->dt_max,
+      .max_retries = tc->max_retries, .shrink = tc->shrink, .grow = tc->grow,
+      .grow_after = tc->grow_after, .failure_memory = tc->failure_memory,
+      .ramp_n_div = scene->division.n_div, .ramp_m = scene->division.m,
+      .order = tc->scheme == SP_TIME_BDF2 ? 2 : 1};
+}
+
+/** The first step from the run's state: the convexity bound
+ *  (sp_scheme_first_dt), at most time.dt and time.dt_max. */
+static double first_dt(const sp_run *run) {
+  const sp_scene_time *tc = &run->scene->time;
+  const double dt = sp_scheme_first_dt(run->layout, run->state, &run->model,
+                                       fmin(tc->dt, tc->dt_max));
+  return fmax(dt, tc->dt_min);
+}
+
+/** The next time a step must land on after @p t: t_end, the next output
+ *  time (output.interval), and with adaptive control the next age division. */
+static double next_event(const sp_run *run, double t) {
+  const sp_scene *scene = run->scene;
+  const double t_end = scene->time.t_end, slack = 1e-12 * t_end;
+  double event = t_end;
+  const double every = scene->output.interval;
+  if (every > 0) {
+    const double k = floor((t + slack) / every) + 1;
+    event = fmin(event, k * every);
+  }
+  if (scene->time.control == SP_CONTROL_ADAPTIVE &&
+      scene->division.criterion == SP_DIVIDE_BY_AGE && run->layout->n_cells < run->n_max) {
+    for (int k = 0; k < run->layout->n_cells; ++k) {
+      const double due = run->birth[k].birth_time + scene->division.t_div;
+      if (due > t + slack) event = fmin(event, due);
+    }
+  }
+  return event;
+}
+
+/** 1 if @p t is a multiple of output.interval (to round-off). */
+static int on_output_time(const sp_scene *scene, double t) {
+  const double every = scene->output.interval;
+  if (!(every > 0)) return 0;
+  const double k = floor(t / every + 0.5);
+  return k > 0 && fabs(t - k * every) <= 1e-12 * scene->time.t_end;
+}
+
+/** The step's source and shape coefficients from c^n (run->state_old and
+ *  run->obs). */
+static int explicit_terms(sp_run *run, sp_shape_coef **shape_coef) {
+  const int n_cells = run->layout->n_cells;
+  if (run->scene->source.rate > 0)
+    SP_CALL(sp_source_fill(run->layout, run->state_old, n_cells, run->source_on,
+                           run->scene->source.rate, run->source));
+  if (!*shape_coef && !(run->scene->shape.delta1 > 0 || run->scene->shape.delta2 > 0))
+    return SP_OK;
+  /* from the observables of c^n; implicit steps follow the new moments
+   * through the gains */
+  sp_shape_coef *grown = realloc(*shape_coef, sizeof *grown * (size_t)n_cells);
+  SP_CHECK(grown, SP_ERR_MEMORY, "out of memory");
+  *shape_coef = grown;
+  SP_CALL(sp_shape_coefficients(n_cells, run->obs, run->birth, run->scene->shape.delta1,
+                                run->scene->shape.delta2, grown));
+  /* the term is the derivative of the moments, which count c only where
+   * c >= the observables' threshold: it acts there only */
+  for (int k = 0; k < n_cells; ++k) grown[k].threshold = run->scene->division.observe_threshold;
+  return SP_OK;
+}
+
+/** Report a failed attempt (Newton failed, or its error estimate was too
+ *  large) on stderr: no silent retries. */
+static void report_failure(const sp_run *run, int step, double t, double dt, const char *why,
+                           const sp_step_report *report, int give_up) {
+  if (run->rank != 0) return;
+  fprintf(stderr, "softpack: step %d at t = %.6g, dt = %.3g: %s", step + 1, t, dt, why);
+  if (report) {
+    fprintf(stderr, "; |F|:");
+    for (int i = 0; i < report->n_residuals; ++i)
+      fprintf(stderr, " %.2e", report->residual_norms[i]);
+  }
+  if (give_up) fprintf(stderr, "; no retry\n");
+  else fprintf(stderr, "; retried with dt = %.3g\n", run->dtc.dt_next);
+}
+
 /** The time loop proper. */
 static int run_steps(sp_run *run, sp_run_summary *sum) {
   const sp_scene_time *tc = &run->scene->time;
-  const sp_scene_division *dv = &run->scene->division;
-  double t = 0.0, dt = tc->dt;
-  int step = 0, successes = 0, failures = 0;
-  int since_division = -1; /* steps since the last division; -1: none yet */
-  /* time.failure_memory: dt's ceiling after a failure, for so many steps */
-  double dt_ceiling = tc->dt;
-  int ceiling_steps = 0;
+  const int adaptive = tc->control == SP_CONTROL_ADAPTIVE;
+  const sp_scheme_kind scheme = tc->scheme == SP_TIME_BDF2 ? SP_SCHEME_BDF2 : SP_SCHEME_BE;
+  const int want_history =
+      adaptive || scheme == SP_SCHEME_BDF2 || run->scene->solver.predictor == SP_PREDICT_LINEAR;
+  sp_dt_params dtp;
+  sp_dt_params_from_scene(run->scene, &dtp);
+  sp_dt_init(&run->dtc, &dtp, first_dt(run));
+  double t = 0.0;
+  int step = 0;
   double *core_mass_old = NULL;
-  sum->dt_smallest = tc->dt;
+  sum->dt_smallest = adaptive ? tc->dt_max : tc->dt;
   SP_CALL(record_energy(run, 0, t, 0.0, 0, NULL, NULL));
   SP_CALL(write_snapshot(run, 0, t));
   const double t_tol = 1e-12 * tc->t_end;
-  /* the shape penalty's per-cell coefficients, refreshed before each step */
-  const int shape_on = run->scene->shape.delta1 > 0 || run->scene->shape.delta2 > 0;
-  sp_shape_coef *shape_coef = NULL;
+  sp_shape_coef *shape_coef = NULL; /* per cell, refreshed before each step */
   sp_step_costs seconds = {0}; /* of the step being attempted */
   double step_start = -1;
   int rc = SP_OK;
   while (rc == SP_OK && t < tc->t_end - t_tol && step < tc->max_steps) {
     if (step_start < 0) step_start = wall_clock(); /* the first attempt of a step */
     const int n_cells = run->layout->n_cells;
-    const size_t n_values = 2 * (size_t)run->layout->n_pairs;
+    const size_t n_pairs = (size_t)run->layout->n_pairs, n_values = 2 * n_pairs;
     if ((long)n_values > sum->unknowns_max) sum->unknowns_max = (long)n_values;
     seconds.unknowns = (long)n_values; /* of the attempt that is accepted */
-    double dt_try = fmin(dt, tc->t_end - t);
-    if (since_division >= 0) /* paper algorithm 2 after a division */
-      dt_try = fmin(dt_try, sp_division_dt(tc->dt, dv->n_div, dv->m, since_division + 1));
+    const double t_event = next_event(run, t);
+    int lands;
+    const double dt_try = sp_dt_propose(&run->dtc, t, t_event, &lands);
     memcpy(run->state_old, run->state, n_values * sizeof(double));
-    if (run->prev_valid) { /* solver.predictor linear: Newton starts from the extrapolation */
-      const double r = fmin(dt_try / run->dt_prev, SP_PREDICTOR_MAX_RATIO);
+    if (run->scene->solver.predictor == SP_PREDICT_LINEAR && run->hist.n >= 1) {
+      /* Newton starts from the extrapolation */
+      const double r = fmin(dt_try / run->hist.dt[0], SP_PREDICTOR_MAX_RATIO);
+      const double *prev = run->hist.past[0];
       for (size_t i = 0; i < n_values; ++i)
-        run->state[i] = run->state_old[i] + r * (run->state_old[i] - run->state_prev[i]);
+        run->state[i] = run->state_old[i] + r * (run->state_old[i] - prev[i]);
     }
-    if (run->scene->source.rate > 0) {
-      rc = sp_source_fill(run->layout, run->state_old, n_cells, run->source_on,
-                          run->scene->source.rate, run->source);
-      if (rc != SP_OK) break;
+    rc = explicit_terms(run, &shape_coef);
+    if (rc != SP_OK) break;
+    const sp_scheme_kind kind = sp_scheme_of_step(scheme, &run->hist);
+    double dt_eff = dt_try;
+    const double *old_eff = run->state_old;
+    if (kind != SP_SCHEME_BE) {
+      sp_scheme_be_form(kind, &run->hist, dt_try, run->state_old, n_pairs, run->state_eff,
+                        &dt_eff);
+      old_eff = run->state_eff;
     }
-    if (shape_on) { /* from the observables of c^n (run->obs); implicit
-                     * steps follow the new moments through the gains */
-      sp_shape_coef *grown_coef = realloc(shape_coef, sizeof *shape_coef * (size_t)n_cells);
-      if (!grown_coef) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
-      shape_coef = grown_coef;
-      rc = sp_shape_coefficients(n_cells, run->obs, run->birth, run->scene->shape.delta1,
-                                 run->scene->shape.delta2, shape_coef);
-      if (rc != SP_OK) break;
-      /* the term is the derivative of the moments, which count c only
-       * where c >= the observables' threshold: it acts there only */
-      for (int k = 0; k < n_cells; ++k)
-        shape_coef[k].threshold = run->scene->division.observe_threshold;
-    }
-    sp_step_data data = {.dt = dt_try, .model = run->model, .state_old = run->state_old,
+    sp_step_data data = {.dt = dt_eff, .model = run->model, .state_old = old_eff,
                          .source = run->scene->source.rate > 0 ? run->source : NULL,
-                         .shape = shape_on ? shape_coef : NULL,
+                         .shape = shape_coef,
                          .shape_implicit = run->scene->shape.scheme == SP_SHAPE_IMPLICIT};
     sp_step_report report;
     int solved = sp_solver_step(run->solver, &data, run->state, &report);
@@ -443,71 +509,61 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                         sp_solver_last_error(run->solver));
       break;
     }
-    if (solved == 1) { /* never accept: shrink and retry from the last good state */
+    double err = -1.0;
+    const char *why = report.reason;
+    char why_error[160];
+    if (solved == 0 && adaptive) {
+      err = sp_scheme_error(kind, &run->hist, dt_try, run->state_old, run->state, n_pairs,
+                            tc->rtol, tc->atol, run->scratch);
+      snprintf(why_error, sizeof why_error,
+               "local error estimate %.3g x the tolerance (time.rtol, time.atol)", err);
+      why = why_error;
+    }
+    int give_up = 0;
+    if (solved == 1) give_up = sp_dt_newton_failed(&run->dtc, dt_try);
+    else if (sp_dt_judge(&run->dtc, dt_try, err) == SP_DT_REJECT) {
+      solved = 1; /* never accepted: retried with a smaller step */
+      give_up = sp_dt_give_up(&run->dtc);
+    }
+    if (solved == 1) { /* retry from the last good state */
       memcpy(run->state, run->state_old, n_values * sizeof(double));
-      ++failures;
       ++seconds.failed_attempts;
       ++sum->failed_attempts;
       seconds.failed_factorisations += report.factorisations;
       sum->failed_factorisations += report.factorisations;
-      successes = 0;
-      dt = dt_try * tc->shrink;
-      if (tc->failure_memory > 0) {
-        dt_ceiling = fmax(dt, dt_try / tc->grow);
-        ceiling_steps = tc->failure_memory;
-      }
-      const int give_up = failures > tc->max_retries || dt < tc->dt_min;
-      if (run->rank == 0) { /* what failed, and the retry: no silent retries */
-        fprintf(stderr, "softpack: step %d at t = %.6g, dt = %.3g: %s; |F|:", step + 1, t,
-                dt_try, report.reason);
-        for (int i = 0; i < report.n_residuals; ++i)
-          fprintf(stderr, " %.2e", report.residual_norms[i]);
-        if (give_up) fprintf(stderr, "; no retry\n");
-        else fprintf(stderr, "; retried with dt = %.3g\n", dt);
-      }
+      report_failure(run, step, t, dt_try, why, err < 0 ? &report : NULL, give_up);
       if (give_up) {
         int rc_out = write_snapshot(run, step, t);
         rc = sp_error_set(SP_ERR_SOLVER,
                           "step %d at t = %.6g failed %d attempts "
                           "(last dt = %.3g; time.max_retries = %d, time.dt_min = %.3g): %s. "
                           "The last good state (t = %.6g) is written%s.",
-                          step + 1, t, failures, dt_try, tc->max_retries, tc->dt_min,
-                          report.reason, t, rc_out == SP_OK ? "" : " (failed: see above)");
+                          step + 1, t, run->dtc.failures, dt_try, tc->max_retries, tc->dt_min,
+                          why, t, rc_out == SP_OK ? "" : " (failed: see above)");
       }
       continue;
     }
     const double t_old = t;
-    t += dt_try;
+    t = lands ? t_event : t + dt_try;
     ++step;
-    failures = 0;
+    sp_dt_accepted(&run->dtc, dt_try, err);
+    seconds.error_estimate = err;
+    if (want_history) {
+      rc = sp_history_push(&run->hist, run->state_old, dt_try, n_values);
+      if (rc != SP_OK) break;
+    }
     sum->steps = step;
     sum->newton_its += report.newton_its;
     sum->factorisations += report.factorisations;
     seconds.factorisations = report.factorisations;
     sum->linear_its += report.linear_its;
     seconds.linear_its = report.linear_its;
-    if (run->scene->solver.predictor == SP_PREDICT_LINEAR) {
-      if (!run->state_prev) {
-        run->state_prev = malloc(n_values * sizeof(double));
-        if (!run->state_prev) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
-      }
-      memcpy(run->state_prev, run->state_old, n_values * sizeof(double));
-      run->dt_prev = dt_try;
-      run->prev_valid = 1;
-    }
     seconds.residual_rise = 0;
     for (int i = 1; i < report.n_residuals; ++i)
       seconds.residual_rise =
           fmax(seconds.residual_rise, report.residual_norms[i] / report.residual_norms[0]);
     sum->t_final = t;
-    if (since_division >= 0) ++since_division;
     if (dt_try < sum->dt_smallest) sum->dt_smallest = dt_try;
-    if (ceiling_steps > 0) --ceiling_steps;
-    const double dt_max = ceiling_steps > 0 ? fmin(tc->dt, dt_ceiling) : tc->dt;
-    if (++successes >= tc->grow_after && dt < dt_max) {
-      dt = fmin(dt * tc->grow, dt_max);
-      successes = 0;
-    }
     /* the core masses before the step, for crossing-safe criteria */
     double *grown = realloc(core_mass_old, sizeof(double) * (size_t)n_cells);
     if (!grown) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
@@ -529,9 +585,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     }
     if (rc != SP_OK) break;
     if (n_divided) {
-      since_division = 0;
       sum->divisions += n_divided;
-      dt = dt_max; /* algorithm 2 now sets the pace */
+      sp_dt_restart(&run->dtc, first_dt(run)); /* algorithm 2, or a new first step */
     }
     if (run->scene->source.rate > 0) {
       double *mass = malloc(sizeof(double) * (size_t)run->layout->n_cells);
@@ -550,7 +605,9 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     step_start = -1;
     if (rc != SP_OK) break;
     const int last = !(t < tc->t_end - t_tol && step < tc->max_steps);
-    if (step % run->scene->output.every == 0 || last || n_divided) rc = write_snapshot(run, step, t);
+    if (step % run->scene->output.every == 0 || last || n_divided ||
+        (lands && on_output_time(run->scene, t)))
+      rc = write_snapshot(run, step, t);
   }
   sum->n_cells = run->layout->n_cells;
   free(shape_coef);
@@ -565,7 +622,9 @@ static void run_free(sp_run *run) {
   sp_mesh_destroy(&run->mesh);
   free(run->state);
   free(run->state_old);
-  free(run->state_prev);
+  free(run->state_eff);
+  free(run->scratch);
+  sp_history_free(&run->hist);
   free(run->obs);
   free(run->energy_t);
   free(run->energy_total);
@@ -620,6 +679,8 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   const int n = scene->n_cells;
   SP_ALLOC(run->state, n_values);
   SP_ALLOC(run->state_old, n_values);
+  SP_ALLOC(run->state_eff, n_values);
+  SP_ALLOC(run->scratch, n_values);
   SP_ALLOC(run->source, run->layout->n_pairs);
   SP_ALLOC(run->obs, n);
   SP_ALLOC(run->birth, n);
@@ -670,7 +731,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
       return sp_error_set(SP_ERR_MEMORY, "out of memory for the local layout");
     }
     sp_layout_transfer(run->layout, run->state, layout, state, 0.0);
-    SP_CALL(adopt_layout(run, layout, state, NULL));
+    SP_CALL(adopt_layout(run, layout, state));
     SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold, run->obs));
   } else {
     SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));

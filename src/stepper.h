@@ -10,6 +10,7 @@
 
 #include <mpi.h>
 
+#include "dt_control.h"
 #include "layout.h"
 #include "mesh.h"
 #include "scene.h"
@@ -51,6 +52,9 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out);
 /** @brief Solver options and model parameters from a scene. */
 void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt);
 void sp_model_from_scene(const sp_scene *scene, sp_model_params *model);
+
+/** @brief The time-step controller's parameters from a scene (dt_control.h). */
+void sp_dt_params_from_scene(const sp_scene *scene, sp_dt_params *params);
 
 /** @brief Hand the solver a mesh and layout (maps and graph are rebuilt
  *         when the layout changed). */

@@ -158,7 +158,8 @@ int main(void) {
                                     {1e17 + 3, -0.0, 5e-324, 1.1}};
   const double shape[3] = {0.0, 1.0 / 9.0, 123.456};
   /* exact in %.4g */
-  const sp_step_costs seconds = {2.5, 0.25, 2.0, 0.125, 0.5, 1, 123456789, 3, 2, 17, 37.5, 4321};
+  const sp_step_costs seconds = {2.5, 0.25, 2.0, 0.125, 0.5, 1, 123456789, 3, 2, 17, 37.5, 4321,
+                                 0.8125};
   for (int r = 0; r < 3; ++r)
     CHECK_OK(sp_output_energy(out, r * 10, tv[r], 2e-4 / 3.0, r + 2, 2,
                               &parts[r], shape[r], r == 1 ? &seconds : NULL));
@@ -182,7 +183,8 @@ int main(void) {
                                    "repulsion,buffer,shape,seconds,assembly_s,"
                                    "factorisation_s,solves_s,supports_s,support_changed,"
                                    "unknowns,factorisations,failed_attempts,"
-                                   "failed_factorisations,residual_rise,linear_its\n";
+                                   "failed_factorisations,residual_rise,linear_its,"
+                                   "error_estimate\n";
       CHECK(strncmp(csv, header, strlen(header)) == 0,
             "energy.csv header: %.80s", csv);
       int rows = 0;
@@ -203,9 +205,13 @@ int main(void) {
         ints[5] = strtol(end + 1, &end, 10);
         const double rise = strtod(end + 1, &end);
         const long linear_its = strtol(end + 1, &end, 10);
+        const double error_estimate = strtod(end + 1, &end);
         CHECK(*end == '\n', "row %d ends with '%c'", rows, *end);
         if (rows < 3) {
-          const sp_step_costs w = rows == 1 ? seconds : (sp_step_costs){0};
+          const sp_step_costs w =
+              rows == 1 ? seconds : (sp_step_costs){.error_estimate = -1}; /* NULL: none */
+          CHECK(error_estimate == w.error_estimate, "row %d error estimate %g, expected %g",
+                rows, error_estimate, w.error_estimate);
           CHECK(v[6] == w.step && v[7] == w.assembly && v[8] == w.factorisation &&
                     v[9] == w.solves && v[10] == w.supports && v[11] == w.support_changed &&
                     ints[2] == w.unknowns && ints[3] == w.factorisations &&

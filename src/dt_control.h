@@ -1,0 +1,134 @@
+/**
+ * @file dt_control.h
+ * @brief How dt is chosen: the one time-step controller (in the spirit of
+ *        PETSc's TSAdapt and SUNDIALS' SUNAdaptController). Every dt
+ *        decision of a run lives here; the time loop (stepper.c) only asks
+ *        for a step, reports what happened and obeys.
+ *
+ * The loop talks to it in four calls:
+ *
+ *     dt = sp_dt_propose(&c, t, t_event);          the step to try
+ *     ...solve...
+ *     Newton failed:          give_up = sp_dt_newton_failed(&c, dt);
+ *     error estimate err:     if (sp_dt_judge(&c, dt, err) == SP_DT_REJECT) retry;
+ *     accepted:               sp_dt_accepted(&c, dt, err);
+ *     a cell divided:         sp_dt_restart(&c, dt_first);
+ *
+ * Two policies (time.control):
+ * - fixed (the paper's): the scene's dt_bar; after a failed Newton solve dt
+ *   shrinks by time.shrink and grows back by time.grow every
+ *   time.grow_after accepted steps (with time.failure_memory); after a
+ *   division the paper's algorithm 2 ramp (sp_division_dt) caps dt.
+ * - adaptive: dt from a local error estimate err (a weighted max-norm of
+ *   the estimated local error of c, 1 = on tolerance; the time scheme
+ *   computes it, time_scheme.h). A step with err > 1 is rejected and
+ *   retried with a smaller dt, never accepted. The next dt comes from a PI
+ *   controller, dt_new = dt * safety * err^(-0.7/k) * err_prev^(0.4/k)
+ *   (k = the estimate's order + 1), bounded by SP_DT_GROW_MAX and
+ *   SP_DT_CUT_MIN and by [dt_min, dt_max]. The first step (and the first
+ *   after a division) has no estimate: the caller passes dt_first, chosen
+ *   from the state (time_scheme.h: sp_scheme_first_dt).
+ *
+ * Both policies land on events (t_end, output times, age divisions in
+ * adaptive mode) without a sliver step: a step that would stop short of an
+ * event by less than its own length is stretched to it when within
+ * SP_DT_STRETCH of dt, else the rest is split into two equal steps.
+ */
+#ifndef SP_DT_CONTROL_H
+#define SP_DT_CONTROL_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum { SP_DT_FIXED = 0, SP_DT_ADAPTIVE = 1 } sp_dt_policy;
+typedef enum { SP_DT_ACCEPT = 0, SP_DT_REJECT = 1 } sp_dt_verdict;
+
+/** The largest factor dt grows by from one step to the next (adaptive); it
+ *  also keeps variable-step BDF2's step ratio below its zero-stability
+ *  limit 1 + sqrt(2). */
+#define SP_DT_GROW_MAX 2.0
+/** The smallest factor a rejected step is cut by (adaptive). */
+#define SP_DT_CUT_MIN 0.2
+/** Safety factor of the adaptive controller. */
+#define SP_DT_SAFETY 0.9
+/** Adaptive: the first step after a division (no error estimate yet, and
+ *  a sharp cut to relax) is at most this fraction of the step before. */
+#define SP_DT_RESTART_FRACTION 0.1
+/** A step may be stretched by this relative amount to land on an event. */
+#define SP_DT_STRETCH 1e-6
+
+/** What the controller is told once, from the scene. */
+typedef struct {
+  sp_dt_policy policy;
+  double dt;       /**< fixed: dt_bar, the step; adaptive: the first step's
+                        cap (and the step where there is no estimate) */
+  double dt_min;   /**< a retry below this ends the run */
+  double dt_max;   /**< adaptive: the largest step */
+  int max_retries; /**< failed attempts of one step before the run stops */
+  /* fixed */
+  double shrink;   /**< dt factor after a failed Newton solve */
+  double grow;     /**< dt factor after grow_after accepted steps */
+  int grow_after;
+  int failure_memory;
+  int ramp_n_div, ramp_m; /**< algorithm 2 after a division (m = 0: none) */
+  /* adaptive */
+  int order;       /**< order of the error estimate's method (1 BE, 2 BDF2) */
+} sp_dt_params;
+
+/** The controller's whole state (plain data: a checkpoint can save it). */
+typedef struct {
+  sp_dt_params p;
+  double dt_next;     /**< the step the policy wants next */
+  int failures;       /**< failed attempts of the step in progress */
+  int successes;      /**< fixed: accepted steps since dt last grew */
+  double ceiling;     /**< fixed: failure memory's cap on dt ... */
+  int ceiling_steps;  /**< ... for this many more accepted steps */
+  int since_restart;  /**< accepted steps since the last division (-1: none) */
+  double err_prev;    /**< adaptive: the last accepted step's estimate (0: none) */
+  double dt_last;     /**< the last accepted step (0: none yet) */
+  int rejected_last;  /**< adaptive: the last attempt was rejected */
+  long n_accepted, n_rejected, n_newton_failed;
+} sp_dt_control;
+
+/** @brief Start a controller; @p dt_first: the first step (adaptive; the
+ *         fixed policy starts at p->dt). */
+void sp_dt_init(sp_dt_control *c, const sp_dt_params *p, double dt_first);
+
+/**
+ * @brief The step to try from @p t: the policy's dt, capped by algorithm 2
+ *        (fixed, after a division) and landing on @p t_event (the next
+ *        event: t_end, an output time, an age division) without a sliver.
+ *        Steps that land on the event return exactly t_event - t.
+ * @param[out] lands 1 if t + dt is the event (the caller then sets t =
+ *        t_event exactly), else 0 (may be NULL)
+ */
+double sp_dt_propose(const sp_dt_control *c, double t, double t_event, int *lands);
+
+/** @brief Adaptive: accept a step with error estimate @p err (err < 0: no
+ *         estimate, accepted), or reject it (err > 1) and set the retry's dt.
+ *         Fixed: always accept. */
+sp_dt_verdict sp_dt_judge(sp_dt_control *c, double dt, double err);
+
+/** @brief A Newton solve at @p dt failed: the retry's dt.
+ *  @return 1 if the run must give up (time.max_retries failures of this step
+ *          or the retry's dt below dt_min), else 0 */
+int sp_dt_newton_failed(sp_dt_control *c, double dt);
+
+/** @brief 1 if the step in progress has failed too often (rejections and
+ *         Newton failures together) or its retry fell below dt_min. */
+int sp_dt_give_up(const sp_dt_control *c);
+
+/** @brief A step of @p dt was accepted with estimate @p err (< 0: none):
+ *         the next dt. */
+void sp_dt_accepted(sp_dt_control *c, double dt, double err);
+
+/** @brief A cell divided: fixed restarts algorithm 2's ramp; adaptive starts
+ *         again without an error history from @p dt_first, at most
+ *         SP_DT_RESTART_FRACTION of the last accepted step. */
+void sp_dt_restart(sp_dt_control *c, double dt_first);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

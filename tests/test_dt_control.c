@@ -1,0 +1,210 @@
+/* The time-step controller alone (src/dt_control.h), no solver: accept and
+ * reject, growth and cut bounds, Newton failures, restart after a division,
+ * landing on events and on t_end without a sliver, and the fixed policy's
+ * rules (the paper's runs). */
+#include <math.h>
+
+#include "check.h"
+#include "division.h"
+#include "dt_control.h"
+#include "error.h"
+
+static sp_dt_params adaptive_params(int order) {
+  sp_dt_params p = {.policy = SP_DT_ADAPTIVE, .dt = 1e-3, .dt_min = 1e-12, .dt_max = 0.5,
+                    .max_retries = 5, .shrink = 0.25, .grow = 2, .grow_after = 3,
+                    .order = order};
+  return p;
+}
+
+static void check_judge(void) {
+  sp_dt_control c;
+  sp_dt_params p = adaptive_params(1);
+  sp_dt_init(&c, &p, 1e-3);
+  CHECK(c.dt_next == 1e-3, "first dt %g", c.dt_next);
+  /* too large an error: rejected, cut, never by more than SP_DT_CUT_MIN */
+  CHECK(sp_dt_judge(&c, 1e-3, 4.0) == SP_DT_REJECT, "err 4 accepted");
+  CHECK(c.dt_next < 1e-3 && c.dt_next >= SP_DT_CUT_MIN * 1e-3 * (1 - 1e-15),
+        "retry after err 4: %g", c.dt_next);
+  CHECK_NEAR(c.dt_next, SP_DT_SAFETY * pow(4.0, -0.5) * 1e-3, 1e-18);
+  CHECK(sp_dt_judge(&c, 1e-3, 1e6) == SP_DT_REJECT, "err 1e6 accepted");
+  CHECK_NEAR(c.dt_next, SP_DT_CUT_MIN * 1e-3, 1e-18);
+  CHECK(sp_dt_judge(&c, 1e-3, NAN) == SP_DT_REJECT, "a NaN estimate accepted");
+  CHECK(sp_dt_judge(&c, 1e-3, INFINITY) == SP_DT_REJECT, "an infinite estimate accepted");
+  CHECK(c.failures == 4 && c.n_rejected == 4, "failures %d, rejected %ld", c.failures,
+        c.n_rejected);
+  CHECK(!sp_dt_give_up(&c), "gave up after 4 of 5 retries");
+  CHECK(sp_dt_judge(&c, 1e-3, 3.0) == SP_DT_REJECT, "err 3 accepted");
+  CHECK(!sp_dt_give_up(&c), "gave up after 5 of 5 retries");
+  CHECK(sp_dt_judge(&c, 1e-3, 3.0) == SP_DT_REJECT && sp_dt_give_up(&c),
+        "no give-up after 6 failed attempts (max_retries 5)");
+  /* on tolerance: accepted */
+  sp_dt_init(&c, &p, 1e-3);
+  CHECK(sp_dt_judge(&c, 1e-3, 1.0) == SP_DT_ACCEPT, "err 1 rejected");
+  CHECK(sp_dt_judge(&c, 1e-3, 0.999) == SP_DT_ACCEPT, "err 0.999 rejected");
+  /* the fixed policy accepts whatever the estimate (it has none) */
+  sp_dt_params f = p;
+  f.policy = SP_DT_FIXED;
+  sp_dt_init(&c, &f, 0);
+  CHECK(sp_dt_judge(&c, 1e-3, 100.0) == SP_DT_ACCEPT, "fixed policy rejected a step");
+}
+
+static void check_growth(void) {
+  sp_dt_control c;
+  sp_dt_params p = adaptive_params(2);
+  sp_dt_init(&c, &p, 1e-3);
+  /* a tiny error: growth by exactly SP_DT_GROW_MAX, never more */
+  sp_dt_accepted(&c, 1e-3, 1e-12);
+  CHECK_NEAR(c.dt_next, SP_DT_GROW_MAX * 1e-3, 1e-18);
+  sp_dt_accepted(&c, c.dt_next, 0.0);
+  CHECK_NEAR(c.dt_next, SP_DT_GROW_MAX * SP_DT_GROW_MAX * 1e-3, 1e-18);
+  /* the PI law: err 0.5 after err_prev */
+  sp_dt_init(&c, &p, 1e-3);
+  sp_dt_accepted(&c, 1e-3, 0.8);
+  const double expect1 = 1e-3 * SP_DT_SAFETY * pow(0.8, -0.7 / 3);
+  CHECK_NEAR(c.dt_next, expect1, 1e-15);
+  sp_dt_accepted(&c, 1e-3, 0.5);
+  const double expect2 = 1e-3 * SP_DT_SAFETY * pow(0.5, -0.7 / 3) * pow(0.8, 0.4 / 3);
+  CHECK_NEAR(c.dt_next, expect2, 1e-15);
+  /* after a rejection the next accepted step does not grow dt */
+  sp_dt_init(&c, &p, 1e-3);
+  CHECK(sp_dt_judge(&c, 1e-3, 2.0) == SP_DT_REJECT, "err 2 accepted");
+  const double retry = c.dt_next;
+  sp_dt_accepted(&c, retry, 1e-6);
+  CHECK(c.dt_next <= retry, "grew right after a rejection: %g > %g", c.dt_next, retry);
+  CHECK(c.failures == 0, "failures not reset by an accepted step");
+  /* bounded by dt_max and dt_min */
+  sp_dt_init(&c, &p, 0.4);
+  sp_dt_accepted(&c, 0.4, 1e-9);
+  CHECK(c.dt_next == 0.5, "dt_max not respected: %g", c.dt_next);
+  /* no estimate (first step): dt held */
+  sp_dt_init(&c, &p, 1e-7);
+  sp_dt_accepted(&c, 1e-7, -1.0);
+  CHECK(c.dt_next == 1e-7, "dt changed without an estimate: %g", c.dt_next);
+}
+
+static void check_newton_failure(void) {
+  sp_dt_control c;
+  sp_dt_params p = adaptive_params(1);
+  p.dt_min = 1e-6;
+  sp_dt_init(&c, &p, 1e-3);
+  CHECK(!sp_dt_newton_failed(&c, 1e-3), "gave up after one failure");
+  CHECK_NEAR(c.dt_next, 0.25e-3, 1e-18);
+  CHECK(!sp_dt_newton_failed(&c, c.dt_next), "gave up after two failures");
+  CHECK(!sp_dt_newton_failed(&c, c.dt_next), "gave up after three failures");
+  CHECK(!sp_dt_newton_failed(&c, c.dt_next), "gave up after four failures");
+  /* 1e-3 / 4^5 < dt_min = 1e-6 */
+  CHECK(sp_dt_newton_failed(&c, c.dt_next), "no give-up below dt_min: %g", c.dt_next);
+}
+
+/* The paper's policy as the stepper had it: shrink on failure, grow by grow
+ * every grow_after successes up to dt_bar, failure memory, algorithm 2. */
+static void check_fixed(void) {
+  sp_dt_params p = {.policy = SP_DT_FIXED, .dt = 2e-4, .dt_min = 1e-14, .dt_max = 1,
+                    .max_retries = 30, .shrink = 0.25, .grow = 2, .grow_after = 3,
+                    .ramp_n_div = 3, .ramp_m = 6, .order = 1};
+  sp_dt_control c;
+  sp_dt_init(&c, &p, 123.0);
+  CHECK(sp_dt_propose(&c, 0, 1, NULL) == 2e-4, "fixed first dt %g", c.dt_next);
+  sp_dt_newton_failed(&c, 2e-4);
+  CHECK(c.dt_next == 5e-5, "after a failure %g", c.dt_next);
+  double seen[7];
+  for (int i = 0; i < 7; ++i) {
+    seen[i] = sp_dt_propose(&c, 0, 1, NULL);
+    sp_dt_accepted(&c, seen[i], -1);
+  }
+  CHECK(seen[0] == 5e-5 && seen[2] == 5e-5 && seen[3] == 1e-4 && seen[5] == 1e-4 &&
+            seen[6] == 2e-4,
+        "regrowth %g %g %g %g %g %g %g", seen[0], seen[1], seen[2], seen[3], seen[4], seen[5],
+        seen[6]);
+  /* algorithm 2 after a division: dt_bar 10^-m ramp^m, n_div steps first */
+  sp_dt_restart(&c, 99.0);
+  for (int a = 1; a <= 6; ++a) {
+    const double dt = sp_dt_propose(&c, 0, 1, NULL);
+    CHECK(dt == sp_division_dt(2e-4, 3, 6, a), "ramp step %d: %g, expected %g", a, dt,
+          sp_division_dt(2e-4, 3, 6, a));
+    sp_dt_accepted(&c, dt, -1);
+  }
+  /* failure memory: dt stays <= dt_f / grow for so many steps */
+  p.failure_memory = 4;
+  sp_dt_init(&c, &p, 0);
+  sp_dt_newton_failed(&c, 2e-4);
+  double largest = 0;
+  for (int i = 0; i < 4; ++i) {
+    const double dt = sp_dt_propose(&c, 0, 1, NULL);
+    largest = fmax(largest, dt);
+    sp_dt_accepted(&c, dt, -1);
+  }
+  CHECK(largest <= 1e-4, "failure memory: %g after failing at 2e-4", largest);
+}
+
+/* Landing: on an event within reach, exactly; no sliver short of it. */
+static void check_landing(void) {
+  sp_dt_params p = adaptive_params(1);
+  sp_dt_control c;
+  sp_dt_init(&c, &p, 1e-3);
+  int lands;
+  double dt = sp_dt_propose(&c, 0.0, 0.0009, &lands);
+  CHECK(lands && dt == 0.0009, "within reach: dt %g, lands %d", dt, lands);
+  dt = sp_dt_propose(&c, 0.0, 0.0015, &lands);
+  CHECK(!lands && dt == 0.00075, "1.5 steps away: dt %g (expected two of 7.5e-4)", dt);
+  dt = sp_dt_propose(&c, 0.0, 0.0025, &lands);
+  CHECK(!lands && dt == 1e-3, "2.5 steps away: dt %g", dt);
+  dt = sp_dt_propose(&c, 0.1, 0.1 + 1e-3 * (1 + 1e-9), &lands);
+  CHECK(lands, "round-off beyond one step does not land");
+
+  /* A whole run to t_end = 0.0137 with events at 0.005 and 0.01 and an
+   * error model err = (dt / 1e-3)^2: every event hit exactly, the last step
+   * on t_end, and no step below half of the one before it that was not cut
+   * by the error (no sliver). */
+  const double t_end = 0.0137, events[] = {0.005, 0.01, t_end};
+  sp_dt_init(&c, &p, 1e-5);
+  double t = 0, dt_prev = 0;
+  int e = 0, steps = 0, hit = 0;
+  while (t < t_end && steps < 10000) {
+    dt = sp_dt_propose(&c, t, events[e], &lands);
+    const double err = (dt / 1e-3) * (dt / 1e-3);
+    if (sp_dt_judge(&c, dt, err) == SP_DT_REJECT) continue;
+    sp_dt_accepted(&c, dt, err);
+    CHECK(!(dt_prev > 0 && dt < 0.45 * dt_prev), "sliver: step %d of %g after %g", steps, dt,
+          dt_prev);
+    t = lands ? events[e] : t + dt;
+    dt_prev = dt;
+    ++steps;
+    if (lands) {
+      CHECK(t == events[e], "landed at %.17g, event %.17g", t, events[e]);
+      ++hit;
+      ++e;
+    }
+  }
+  CHECK(hit == 3 && t == t_end, "%d events hit, t = %.17g", hit, t);
+  CHECK(c.n_rejected <= 2, "%ld rejections on a smooth error model", c.n_rejected);
+  printf("landing: %d steps, %ld rejected, last dt %g\n", steps, c.n_rejected, dt_prev);
+}
+
+static void check_restart(void) {
+  sp_dt_params p = adaptive_params(2);
+  sp_dt_control c;
+  sp_dt_init(&c, &p, 1e-6);
+  sp_dt_accepted(&c, 1e-6, 0.3);
+  sp_dt_accepted(&c, c.dt_next, 0.3);
+  CHECK(c.err_prev > 0 && c.dt_next > 1e-6, "no growth on small errors");
+  sp_dt_restart(&c, 2e-8);
+  CHECK(c.dt_next == 2e-8 && c.err_prev == 0 && c.since_restart == 0,
+        "restart: dt %g, err_prev %g, since %d", c.dt_next, c.err_prev, c.since_restart);
+  sp_dt_accepted(&c, 2e-8, -1);
+  CHECK(c.dt_next == 2e-8, "first step after a restart has no estimate: dt %g", c.dt_next);
+  /* at most a tenth of the last accepted step */
+  sp_dt_accepted(&c, 3e-6, 0.5);
+  sp_dt_restart(&c, 1.0);
+  CHECK(c.dt_next == SP_DT_RESTART_FRACTION * 3e-6, "restart after 3e-6: dt %g", c.dt_next);
+}
+
+int main(void) {
+  check_judge();
+  check_growth();
+  check_newton_failure();
+  check_fixed();
+  check_landing();
+  check_restart();
+  TEST_DONE();
+}
