@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# The work-precision report (docs/time-stepping.md): error against wall time
+# and against factorisations for fixed-dt backward Euler (the paper's
+# method) at dt, dt/2, dt/4, dt/8, adaptive BE and adaptive BDF2 at several
+# tolerances, and the default configuration, each against a reference run.
+#
+#   bench/work_precision.sh a [OUT]   three overlapping cells relaxing,
+#                                     inputs/bench/relax_3.yaml (64 x 64, T = 0.02)
+#   bench/work_precision.sh b [OUT]   the paper's run 5, inputs/paper/embryo_8.yaml
+#                                     (1 -> 8 cells, divisions; T = 0.016)
+#
+# Environment: REF_TOL (the reference: adaptive BDF2 at rtol = atol =
+# REF_TOL; default 1e-5), TOLS_BE, TOLS_BDF2 (tolerance lists), FIXED
+# (divisors of dt, default "1 2 4 8"), SOLVER (extra --set options of every
+# run but "today"; default: the program's defaults), SKIP_REF=1 (reuse the
+# reference in OUT). Every run logs at multiples of output.interval
+# (INTERVAL, default 0.002), where the energies are compared.
+# Rows: name, steps, factorisations (accepted and failed attempts), failed
+# attempts, wall seconds (sum of the per-step seconds), then the errors
+# against the reference (bench/bench_compare_runs.c): the largest relative
+# energy error at the common times, the largest relative mass error and
+# centre distance of the cells at T, and the relative L2 norm of the
+# fields' difference at T. "today" is the configuration before
+# time.control existed: fixed BE at dt with SuperLU, no predictor, no
+# Jacobian reuse. Plots: OUT/wp_<scene>_{factorisations,wall}.png.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+which=${1:-a}
+case "$which" in
+  a) scene=inputs/bench/relax_3.yaml ;;
+  b) scene=inputs/paper/embryo_8.yaml ;;
+  *) echo "usage: bench/work_precision.sh a|b [OUT]" >&2; exit 2 ;;
+esac
+out=${2:-out/work_precision_$which}
+ref_tol=${REF_TOL:-1e-5}
+tols_be=${TOLS_BE:-"1e-1 3e-2 1e-2"}
+tols_bdf2=${TOLS_BDF2:-"3e-1 1e-1 3e-2 1e-2"}
+fixed=${FIXED:-"1 2 4 8"}
+interval=${INTERVAL:-0.002}
+read -r -a solver <<< "${SOLVER:-}"
+export OMP_NUM_THREADS=1
+mkdir -p "$out"
+common=(--set output.interval="$interval" --set output.every=100000000
+        --set output.pictures=false)
+dt=$(awk '/^time:/ { if (match($0, /dt: *[0-9.eE+-]+/)) { s = substr($0, RSTART, RLENGTH);
+       sub(/dt: */, "", s); print s } }' "$scene")
+dt=${dt:-2e-4}
+
+run() { # NAME SET...
+  local name=$1
+  shift
+  echo "softpack run $scene $* (-> $out/$name)" >&2
+  build/softpack run "$scene" --out "$out/$name" "${common[@]}" "$@" > "$out/$name.log" 2>&1 ||
+    { echo "run $name failed: see $out/$name.log" >&2; return 1; }
+}
+
+echo "# bench/work_precision.sh $which, $(date -u +%Y-%m-%d), $(nproc) cores, scene $scene"
+echo "# reference: adaptive BDF2, rtol = atol = $ref_tol; solver options: ${SOLVER:-defaults}"
+if [ "${SKIP_REF:-0}" != 1 ]; then
+  run ref --set time.control=adaptive --set time.scheme=bdf2 --set time.rtol="$ref_tol" \
+      --set time.atol="$ref_tol" "${solver[@]}"
+fi
+names=()
+run today --set time.control=fixed --set time.scheme=be --set time.dt="$dt" \
+    --set solver.linear=superlu --set solver.predictor=none --set solver.jacobian_reuse=0 &&
+  names+=(today)
+for f in $fixed; do
+  d=$(awk -v dt="$dt" -v f="$f" 'BEGIN { printf "%.10g", dt / f }')
+  run "fixed_be_dt$f" --set time.control=fixed --set time.scheme=be --set time.dt="$d" \
+      "${solver[@]}" && names+=("fixed_be_dt$f")
+done
+for tol in $tols_be; do
+  run "adaptive_be_$tol" --set time.control=adaptive --set time.scheme=be \
+      --set time.rtol="$tol" --set time.atol="$tol" "${solver[@]}" && names+=("adaptive_be_$tol")
+done
+for tol in $tols_bdf2; do
+  run "adaptive_bdf2_$tol" --set time.control=adaptive --set time.scheme=bdf2 \
+      --set time.rtol="$tol" --set time.atol="$tol" "${solver[@]}" &&
+    names+=("adaptive_bdf2_$tol")
+done
+run default "${solver[@]}" && names+=(default)
+
+printf "| %-20s | %5s | %6s | %6s | %8s | %9s | %9s | %9s | %9s |\n" run steps facts failed \
+  wall_s energy mass centre L2
+echo "|---|---|---|---|---|---|---|---|---|"
+points=()
+for n in "${names[@]}"; do
+  read -r steps facts failed wall e m c l2 < <(build/bench/bench_compare_runs "$out/$n" "$out/ref")
+  printf "| %-20s | %5d | %6d | %6d | %8.1f | %9.2e | %9.2e | %9.2e | %9.2e |\n" "$n" "$steps" \
+    "$facts" "$failed" "$wall" "$e" "$m" "$c" "$l2"
+  series=${n%_*}
+  case "$n" in fixed_*) series=fixed_be ;; today|default) series=$n ;; esac
+  points+=("$series $facts $l2 $wall")
+done
+for axis in factorisations wall; do
+  for p in "${points[@]}"; do
+    read -r s f l2 w <<< "$p"
+    if [ "$axis" = factorisations ]; then echo "$s $f $l2"; else echo "$s $w $l2"; fi
+  done | build/bench/bench_wp_plot "$out/wp_${which}_$axis.png" \
+    "$( [ "$axis" = wall ] && echo "wall seconds" || echo "factorisations")" \
+    "relative L2 error of c at T" "work-precision, scene $which ($(date -u +%Y-%m-%d))"
+done
+echo "# plots: $out/wp_${which}_factorisations.png, $out/wp_${which}_wall.png"
