@@ -2,14 +2,14 @@
 # ctest deb_package (labels install, deb): cpack -G DEB builds the package,
 # which is inspected and unpacked, never installed (that needs root and
 # changes the machine: docs/install.md gives the commands by hand).
-#   deb_package.sh BUILD_DIR CPACK VERSION SONAME_VERSION RUNTIME_PACKAGE...
+#   deb_package.sh BUILD_DIR CPACK VERSION SONAME_VERSION LIBDIR RUNTIME_PACKAGE...
 # Checks: the control fields (name, version, Depends naming openmpi-bin and
 # every runtime package CMake lists), the files under /usr, and the
 # unpacked bin/softpack running with the libsoftpack beside it.
 # Exit status 77 (skipped) without dpkg-deb.
 set -euo pipefail
-build=$1 cpack=$2 version=$3 soversion=$4
-shift 4
+build=$1 cpack=$2 version=$3 soversion=$4 lib=$5
+shift 5
 command -v dpkg-deb > /dev/null || { echo "no dpkg-deb: skipped"; exit 77; }
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/softpack_deb.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
@@ -30,8 +30,8 @@ for package in openmpi-bin "$@"; do
 done
 
 dpkg-deb -c "$deb" | awk '{print $6}' > "$tmp/files"
-for f in ./usr/bin/softpack "./usr/lib/libsoftpack.so.$soversion" ./usr/include/softpack/scene.h \
-         ./usr/lib/cmake/softpack/softpackConfig.cmake ./usr/lib/pkgconfig/softpack.pc \
+for f in ./usr/bin/softpack "./usr/$lib/libsoftpack.so.$soversion" ./usr/include/softpack/scene.h \
+         "./usr/$lib/cmake/softpack/softpackConfig.cmake" "./usr/$lib/pkgconfig/softpack.pc" \
          ./usr/share/softpack/inputs/default.yaml ./usr/share/softpack/inputs/paper/embryo_8.yaml \
          ./usr/share/softpack/doc/README.md; do
   grep -qxF "$f" "$tmp/files" || fail "the package has no $f"

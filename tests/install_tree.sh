@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # ctest install_tree (label install): the installed tree stands on its own.
-#   install_tree.sh BUILD_DIR SOURCE_DIR CMAKE PKG_CONFIG C_COMPILER
+#   install_tree.sh BUILD_DIR SOURCE_DIR CMAKE PKG_CONFIG C_COMPILER LIBDIR
 # 1. cmake --install into a temporary prefix; no installed file names the
 #    source or build tree (debug sections aside), the config files neither.
 # 2. examples/ configured with find_package(softpack) against the prefix,
@@ -12,7 +12,7 @@
 #    scene (two short steps) from a directory outside the source tree, with
 #    libsoftpack found in the moved prefix.
 set -euo pipefail
-build=$1 source=$2 cmake=$3 pkg_config=$4 cc=$5
+build=$1 source=$2 cmake=$3 pkg_config=$4 cc=$5 lib=$6
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/softpack_install.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "install_tree: FAIL: $*" >&2; exit 1; }
@@ -20,16 +20,16 @@ export OMP_NUM_THREADS=1
 
 prefix=$tmp/prefix
 "$cmake" --install "$build" --prefix "$prefix" > "$tmp/install.log"
-for f in bin/softpack lib/cmake/softpack/softpackConfig.cmake \
-         lib/cmake/softpack/softpackConfigVersion.cmake lib/pkgconfig/softpack.pc \
+for f in bin/softpack $lib/cmake/softpack/softpackConfig.cmake \
+         $lib/cmake/softpack/softpackConfigVersion.cmake $lib/pkgconfig/softpack.pc \
          include/softpack/scene.h include/softpack/softpack_solver.h \
          share/softpack/inputs/default.yaml share/softpack/inputs/paper/embryo_8.yaml \
          share/softpack/doc/README.md share/softpack/doc/docs/scene.md; do
   [ -e "$prefix/$f" ] || fail "$f is not installed"
 done
-soname=$(objdump -p "$prefix"/lib/libsoftpack.so | awk '$1 == "SONAME" {print $2}')
+soname=$(objdump -p "$prefix/$lib"/libsoftpack.so | awk '$1 == "SONAME" {print $2}')
 [[ $soname =~ ^libsoftpack\.so\.[0-9] ]] || fail "libsoftpack's soname is '$soname'"
-[ -e "$prefix/lib/$soname" ] || fail "no lib/$soname"
+[ -e "$prefix/$lib/$soname" ] || fail "no $lib/$soname"
 echo "installed: $(cd "$prefix" && find . -type f | wc -l) files, soname $soname"
 # Nothing installed may point into the trees it was built from.
 for tree in "$(cd "$source" && pwd -P)" "$(cd "$build" && pwd -P)"; do
@@ -60,8 +60,8 @@ status=0
   fail "bad override: status $status, $(cat "$tmp/bad.err")"
 
 # pkg-config --cflags --libs softpack
-flags=$(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" "$pkg_config" --cflags --libs softpack)
-libdir=$(PKG_CONFIG_PATH="$prefix/lib/pkgconfig" "$pkg_config" --variable=libdir softpack)
+flags=$(PKG_CONFIG_PATH="$prefix/$lib/pkgconfig" "$pkg_config" --cflags --libs softpack)
+libdir=$(PKG_CONFIG_PATH="$prefix/$lib/pkgconfig" "$pkg_config" --variable=libdir softpack)
 echo "pkg-config: $flags"
 # shellcheck disable=SC2086 # the flags are words
 "$cc" "$source/examples/scene_facts.c" -o "$tmp/scene_facts_pc" $flags -Wl,-rpath,"$libdir"
@@ -72,7 +72,7 @@ mv "$prefix" "$tmp/moved"
 mkdir "$tmp/work"
 cd "$tmp/work"
 loaded=$(ldd "$tmp/moved/bin/softpack" | awk '/libsoftpack/ {print $3}')
-[ "$(realpath "$loaded")" = "$(realpath "$tmp/moved/lib/$soname")" ] ||
+[ "$(realpath "$loaded")" = "$(realpath "$tmp/moved/$lib/$soname")" ] ||
   fail "the moved bin/softpack loads libsoftpack from '$loaded'"
 "$tmp/moved/bin/softpack" run "$tmp/moved/share/softpack/inputs/default.yaml" \
   --set time.dt=1e-6 --set time.t_end=1e-5 --set time.max_steps=2 --set output.pictures=false
