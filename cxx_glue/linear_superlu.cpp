@@ -125,8 +125,6 @@ class SuperLU final : public DirectSolver {
 
 std::unique_ptr<DirectSolver> make_superlu() { return std::make_unique<SuperLU>(); }
 
-#define SP_STR_(x) #x
-#define SP_STR(x) SP_STR_(x)
 const char *superlu_version() {
   return "SuperLU " SP_STR(SUPERLU_MAJOR_VERSION) "." SP_STR(SUPERLU_MINOR_VERSION) "." SP_STR(
       SUPERLU_PATCH_VERSION) " (dgstrf; gathered on rank 0 under MPI)";

@@ -257,8 +257,6 @@ std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, 
   return std::make_unique<SuperLUDist>(comm, pair_order, refine);
 }
 
-#define SP_STR_(x) #x
-#define SP_STR(x) SP_STR_(x)
 const char *superlu_dist_version() {
   return "SuperLU_DIST " SP_STR(SUPERLU_DIST_MAJOR_VERSION) "." SP_STR(
       SUPERLU_DIST_MINOR_VERSION) "." SP_STR(SUPERLU_DIST_PATCH_VERSION) " (pdgssvx)";
