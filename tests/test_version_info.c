@@ -6,25 +6,10 @@
 #include <mpi.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include "check.h"
+#include "command.h"
 #include "scene.h"
-
-static int run(const char *cmd_line, char *out, size_t size) {
-  FILE *p = popen(cmd_line, "r");
-  if (!p) return -1;
-  size_t n = fread(out, 1, size - 1, p);
-  out[n] = '\0';
-  int status = pclose(p);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-static int softpack(const char *args, char *out, size_t size) {
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "OMP_NUM_THREADS=1 %s %s 2>&1", SP_BINARY, args);
-  return run(cmd, out, size);
-}
 
 /** The text after "key: " up to the end of its line, or "" if absent. */
 static void line_after(const char *text, const char *key, char *value, size_t size) {
@@ -40,18 +25,18 @@ int main(int argc, char **argv) {
   char out[8192], want[512], git[128] = "";
 
   /* The revision the source is at: what the build must have recorded. */
-  run("cd " SP_SOURCE_DIR " && test \"$(git rev-parse --show-toplevel 2>/dev/null)\" = "
+  run_command("cd " SP_SOURCE_DIR " && test \"$(git rev-parse --show-toplevel 2>/dev/null)\" = "
       "\"$(pwd -P)\" && git rev-parse --short=12 HEAD",
       git, sizeof git);
   git[strcspn(git, "\n")] = '\0';
-  CHECK(softpack("--version", out, sizeof out) == 0, "--version: %s", out);
+  CHECK(run_softpack("--version", out, sizeof out) == 0, "--version: %s", out);
   snprintf(want, sizeof want, "softpack %s (git %s", SP_PROJECT_VERSION,
            git[0] ? git : "unknown)");
   printf("--version: %s", out);
   CHECK(strncmp(out, want, strlen(want)) == 0, "--version prints '%s', want it to begin '%s'",
         out, want);
 
-  CHECK(softpack("info", out, sizeof out) == 0, "info: %s", out);
+  CHECK(run_softpack("info", out, sizeof out) == 0, "info: %s", out);
   printf("info:\n%s", out);
   CHECK(strncmp(out, want, strlen(want)) == 0, "info does not begin with the version line");
   char value[1024];
@@ -87,11 +72,11 @@ int main(int argc, char **argv) {
   line_after(out, "MPI processes: ", value, sizeof value);
   CHECK(strcmp(value, "1") == 0, "MPI processes '%s', want 1", value);
 
-  CHECK(softpack("info extra", out, sizeof out) == 2 && strstr(out, "extra"),
+  CHECK(run_softpack("info extra", out, sizeof out) == 2 && strstr(out, "extra"),
         "info extra: %s", out);
-  CHECK(softpack("--version extra", out, sizeof out) == 2 && strstr(out, "extra"),
+  CHECK(run_softpack("--version extra", out, sizeof out) == 2 && strstr(out, "extra"),
         "--version extra: %s", out);
-  CHECK(softpack("--help", out, sizeof out) == 0 && strstr(out, "softpack info") &&
+  CHECK(run_softpack("--help", out, sizeof out) == 0 && strstr(out, "softpack info") &&
             strstr(out, "softpack --version"),
         "--help names neither info nor --version: %s", out);
   MPI_Finalize();
