@@ -222,6 +222,19 @@ int sp_solver_time_jacobian(sp_solver s, const sp_step_data *data,
                             const double *state, int kind, int repeats,
                             double *seconds_fill, double *seconds_elements);
 
+/** @brief The Trilinos release the glue was compiled against ("13.2"). */
+const char *sp_solver_trilinos_version(void);
+
+/**
+ * @brief What serves a linear solver in this build (softpack info).
+ * @param[in] linear SP_SOLVER_SUPERLU, ...
+ * @param[out] backend the library behind it and its version, e.g.
+ *             "SuperLU 5.3.0 (dgstrf)" (static text; NULL: not wanted)
+ * @return 1 if this build can use it, 0 if not (an Amesos built without
+ *         it), -1 for an unknown @p linear
+ */
+int sp_solver_linear_backend(int linear, const char **backend);
+
 /** @brief The message of the last failed call on @p s. */
 const char *sp_solver_last_error(sp_solver s);
 

@@ -4,6 +4,9 @@
 #include <stdexcept>
 #include <string>
 
+#include <Trilinos_version.h>
+
+#include "linear.hpp"
 #include "newton.hpp"
 #include "softpack_solver.h"
 
@@ -41,6 +44,33 @@ bool valid_kind(int kind) {
 }  // namespace
 
 extern "C" {
+
+const char *sp_solver_trilinos_version(void) { return TRILINOS_VERSION_STRING; }
+
+int sp_solver_linear_backend(int linear, const char **backend) {
+  const char *what = nullptr;
+  int available = 1;
+  try {
+    switch (linear) {
+      case SP_SOLVER_SUPERLU: what = sp::superlu_version(); break;
+      case SP_SOLVER_SUPERLU_DIST: what = sp::superlu_dist_version(); break;
+      case SP_SOLVER_MUMPS:
+        what = sp::amesos_version("Amesos_Mumps");
+        available = sp::amesos_available("Amesos_Mumps");
+        break;
+      case SP_SOLVER_KLU2:
+        what = sp::amesos_version("Amesos_Klu");
+        available = sp::amesos_available("Amesos_Klu");
+        break;
+      case SP_SOLVER_GMRES_ILU: what = sp::krylov_version(); break;
+      default: return -1;
+    }
+  } catch (...) {
+    available = 0;
+  }
+  if (backend) *backend = what;
+  return available;
+}
 
 int sp_solver_create(MPI_Comm comm, const sp_solver_options *options, sp_solver *out) {
   if (!options || !out) return SP_API_ERR + 1;

@@ -81,5 +81,17 @@ struct KrylovOptions {
 };
 std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options);
 
+// The library behind each backend and its version, from the headers the
+// glue was compiled with (softpack info); static text. SP_STR makes a
+// string of a version macro's value.
+#define SP_STR_(x) #x
+#define SP_STR(x) SP_STR_(x)
+const char *superlu_version();
+const char *superlu_dist_version();
+const char *amesos_version(const std::string &which);
+// Whether this Trilinos' Amesos was built with "Amesos_Mumps", "Amesos_Klu".
+bool amesos_available(const std::string &which);
+const char *krylov_version();
+
 }  // namespace sp
 #endif

@@ -119,4 +119,12 @@ std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &whic
   return std::make_unique<AmesosSolver>(comm, which);
 }
 
+bool amesos_available(const std::string &which) { return Amesos().Query(which); }
+
+const char *amesos_version(const std::string &which) {
+  if (which == "Amesos_Mumps") return "MUMPS " MUMPS_VERSION " through Amesos";
+  if (which == "Amesos_Klu") return "Amesos' own KLU (one process only)";
+  return "unknown";
+}
+
 }  // namespace sp

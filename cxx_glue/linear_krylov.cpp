@@ -95,4 +95,6 @@ std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &op
   return std::make_unique<KrylovSolver>(comm, options);
 }
 
+const char *krylov_version() { return "AztecOO GMRES, Ifpack ILU(k)"; }
+
 }  // namespace sp

@@ -125,4 +125,9 @@ class SuperLU final : public DirectSolver {
 
 std::unique_ptr<DirectSolver> make_superlu() { return std::make_unique<SuperLU>(); }
 
+const char *superlu_version() {
+  return "SuperLU " SP_STR(SUPERLU_MAJOR_VERSION) "." SP_STR(SUPERLU_MINOR_VERSION) "." SP_STR(
+      SUPERLU_PATCH_VERSION) " (dgstrf; gathered on rank 0 under MPI)";
+}
+
 }  // namespace sp

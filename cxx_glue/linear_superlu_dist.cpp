@@ -257,4 +257,9 @@ std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, 
   return std::make_unique<SuperLUDist>(comm, pair_order, refine);
 }
 
+const char *superlu_dist_version() {
+  return "SuperLU_DIST " SP_STR(SUPERLU_DIST_MAJOR_VERSION) "." SP_STR(
+      SUPERLU_DIST_MINOR_VERSION) "." SP_STR(SUPERLU_DIST_PATCH_VERSION) " (pdgssvx)";
+}
+
 }  // namespace sp

@@ -5,6 +5,8 @@
  *   softpack run SCENE.yaml [--out DIR] [--set section.key=value]...
  *   softpack keys        print every scene key (the table of docs/scene.md)
  *   softpack check-jacobian SCENE.yaml [--steps K] [--set section.key=value]...
+ *   softpack info        the build: type, Trilinos, linear solvers, BLAS, MPI
+ *   softpack --version   the version and the git revision it was built from
  *   softpack --help
  *
  * Exit status: 0 success, 2 bad input (nothing written), 1 any other failure.
@@ -14,9 +16,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "build_info.h"
 #include "checkjac.h"
 #include "error.h"
 #include "scene.h"
+#include "sp_revision.h" /* SP_GIT_REVISION, generated at build time */
 #include "stepper.h"
 
 static void usage(FILE *to) {
@@ -25,10 +29,17 @@ static void usage(FILE *to) {
           "       softpack keys      print every scene key with unit, default and range\n"
           "       softpack check-jacobian SCENE.yaml [--steps K] [--set section.key=value]...\n"
           "                          compare the ad, hand and fd element Jacobians\n"
+          "       softpack info      the build: type, Trilinos, linear solvers, BLAS, MPI\n"
+          "       softpack --version the version and the git revision\n"
           "       softpack --help\n"
           "Outputs go to DIR (default out/<scene name>): energy.csv, cells.csv,\n"
           "fields.pvd + fields_*.vtu (ParaView), cells_*.png, energy.png.\n"
           "Exit status: 0 ok, 2 bad input (nothing written), 1 failure.\n");
+}
+
+/** "softpack 0.1 (git 0123456789ab)": --version, and the first line of info. */
+static void print_version(FILE *to) {
+  fprintf(to, "softpack %s (git %s)\n", sp_version(), SP_GIT_REVISION);
 }
 
 /** out/<basename of the scene without .yaml> */
@@ -95,6 +106,14 @@ int main(int argc, char **argv) {
   int rc = SP_OK;
   if (argc >= 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
     if (rank == 0) usage(stdout);
+  } else if ((argc >= 2 && strcmp(argv[1], "--version") == 0) ||
+             (argc >= 2 && strcmp(argv[1], "info") == 0)) {
+    if (argc > 2)
+      rc = sp_error_set(SP_ERR_INPUT, "softpack %s takes no arguments, got %s", argv[1], argv[2]);
+    else if (rank == 0) {
+      print_version(stdout);
+      if (strcmp(argv[1], "info") == 0) sp_build_info_print(stdout, MPI_COMM_WORLD);
+    }
   } else if (argc >= 2 && strcmp(argv[1], "keys") == 0) {
     if (rank == 0) sp_scene_print_keys(stdout);
   } else if (argc >= 2 && strcmp(argv[1], "run") == 0) {

@@ -562,6 +562,12 @@ static const char *word_of(const sp_key *key, double value) {
   return "?";
 }
 
+const char *sp_scene_linear_name(sp_linear_kind kind) {
+  for (size_t i = 0; i < sizeof sp_linear_words / sizeof sp_linear_words[0]; ++i)
+    if (sp_linear_words[i].val == (int64_t)kind) return sp_linear_words[i].str;
+  return "?";
+}
+
 /** The allowed range: "> 0", ">= 1", "[1, 4096]", "(0, 1)", "any". */
 static const char *range_text(const sp_key *key, char *buf, size_t size) {
   const sp_bound *lo = &key->lower, *hi = &key->upper;

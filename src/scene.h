@@ -203,6 +203,10 @@ int sp_scene_load(const char *path, int n_set, const char *const *set,
 /** @brief Interface width d = sqrt(kappa / (2 alpha)) of the scene's model. */
 double sp_scene_interface_width(const sp_scene *scene);
 
+/** @brief The scene word of a linear solver (solver.linear): "superlu",
+ *         ...; "?" for an unknown @p kind. */
+const char *sp_scene_linear_name(sp_linear_kind kind);
+
 /** @brief Print every key (markdown table: key, type, unit, default, range,
  *         meaning): the source of docs/scene.md. */
 void sp_scene_print_keys(FILE *out);

@@ -353,6 +353,14 @@ static int cmd_cli(void) {
   snprintf(args, sizeof args,
            "run %s --out /proc/mpi_compare_cannot_write --set output.pictures=false", scene);
   expect_failure("unwritable --out, np 2", args, 1, "softpack: error");
+  /* info reports the processes it runs on, once (rank 0 prints). */
+  char out[16384];
+  double seconds = 0;
+  CHECK(run_mpi(2, "info", out, sizeof out, &seconds) == 0, "info, np 2: %s", out);
+  const char *size_line = strstr(out, "MPI processes: ");
+  CHECK(size_line && strncmp(size_line, "MPI processes: 2\n", 17) == 0 &&
+            !strstr(size_line + 1, "MPI processes: "),
+        "info, np 2 does not say 'MPI processes: 2' once:\n%s", out);
   TEST_DONE();
 }
 

@@ -4,20 +4,9 @@
 #include <dirent.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 
 #include "check.h"
-
-static int run(const char *args, char *out, size_t size) {
-  char cmd[4096];
-  snprintf(cmd, sizeof cmd, "OMP_NUM_THREADS=1 %s %s 2>&1", SP_BINARY, args);
-  FILE *p = popen(cmd, "r");
-  if (!p) return -1;
-  size_t n = fread(out, 1, size - 1, p);
-  out[n] = '\0';
-  int status = pclose(p);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+#include "command.h"
 
 static int exists(const char *path) {
   struct stat st;
@@ -27,7 +16,7 @@ static int exists(const char *path) {
 static void expect_input_error(const char *args, const char *key) {
   char out[8192];
   system("rm -rf cli_out");
-  int status = run(args, out, sizeof out);
+  int status = run_softpack(args, out, sizeof out);
   CHECK(status == 2, "'%s': exit status %d, output: %s", args, status, out);
   CHECK(strstr(out, key) != NULL, "'%s': message does not name '%s': %s", args, key, out);
   CHECK(!exists("cli_out"), "'%s': the output directory was created", args);
@@ -70,6 +59,6 @@ int main(void) {
   expect_input_error(args, "--frobnicate");
   expect_input_error("explode", "explode");
   char out[8192];
-  CHECK(run("--help", out, sizeof out) == 0 && strstr(out, "usage"), "--help: %s", out);
+  CHECK(run_softpack("--help", out, sizeof out) == 0 && strstr(out, "usage"), "--help: %s", out);
   TEST_DONE();
 }

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# ctest deb_package (labels install, deb): cpack -G DEB builds the package,
+# which is inspected and unpacked, never installed (that needs root and
+# changes the machine: docs/install.md gives the commands by hand).
+#   deb_package.sh BUILD_DIR CPACK VERSION SONAME_VERSION LIBDIR RUNTIME_PACKAGE...
+# Checks: the control fields (name, version, Depends naming openmpi-bin and
+# every runtime package CMake lists), the files under /usr, and the
+# unpacked bin/softpack running with the libsoftpack beside it.
+# Exit status 77 (skipped) without dpkg-deb.
+set -euo pipefail
+build=$1 cpack=$2 version=$3 soversion=$4 lib=$5
+shift 5
+command -v dpkg-deb > /dev/null || { echo "no dpkg-deb: skipped"; exit 77; }
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/softpack_deb.XXXXXX")
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "deb_package: FAIL: $*" >&2; exit 1; }
+
+"$cpack" -G DEB -B "$tmp" --config "$build/CPackConfig.cmake" > "$tmp/cpack.log" ||
+  { cat "$tmp/cpack.log"; fail "cpack"; }
+debs=("$tmp"/softpack_*.deb)
+[ ${#debs[@]} -eq 1 ] && [ -f "${debs[0]}" ] || fail "cpack made no single softpack_*.deb"
+deb=${debs[0]}
+echo "built $(basename "$deb")"
+dpkg-deb -I "$deb"
+[ "$(dpkg-deb -f "$deb" Package)" = softpack ] || fail "package name"
+[ "$(dpkg-deb -f "$deb" Version)" = "$version" ] || fail "version $(dpkg-deb -f "$deb" Version)"
+depends=$(dpkg-deb -f "$deb" Depends)
+for package in openmpi-bin "$@"; do
+  grep -Eq "(^|, )$package( |,|$)" <<< "$depends" || fail "Depends lacks $package: $depends"
+done
+
+dpkg-deb -c "$deb" | awk '{print $6}' > "$tmp/files"
+for f in ./usr/bin/softpack "./usr/$lib/libsoftpack.so.$soversion" ./usr/include/softpack/scene.h \
+         "./usr/$lib/cmake/softpack/softpackConfig.cmake" "./usr/$lib/pkgconfig/softpack.pc" \
+         ./usr/share/softpack/inputs/default.yaml ./usr/share/softpack/inputs/paper/embryo_8.yaml \
+         ./usr/share/softpack/doc/README.md; do
+  grep -qxF "$f" "$tmp/files" || fail "the package has no $f"
+done
+echo "$(wc -l < "$tmp/files") entries, the expected files among them"
+
+dpkg-deb -x "$deb" "$tmp/root"
+out=$(OMP_NUM_THREADS=1 "$tmp/root/usr/bin/softpack" --version)
+[[ $out == "softpack $version "* ]] || fail "the unpacked softpack --version says '$out'"
+echo "unpacked: $out"
+echo "deb_package: all checks passed"
