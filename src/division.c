@@ -71,6 +71,12 @@ int sp_division_due(const sp_division_params *params, const sp_cell_birth *birth
   return quantity >= due_level(params, threshold);
 }
 
+double sp_division_threshold(const sp_division_params *params, const sp_cell_birth *birth) {
+  double quantity, threshold;
+  watched(params, birth, 0.0, 0.0, &quantity, &threshold);
+  return threshold;
+}
+
 double sp_division_crossing_fraction(const sp_division_params *params,
                                      const sp_cell_birth *birth, double t_old,
                                      double t_new, double mass_old,

@@ -116,6 +116,10 @@ sp_cell_birth sp_cell_birth_make(double t, const sp_cell_obs *obs, int generatio
 int sp_division_due(const sp_division_params *params, const sp_cell_birth *birth,
                     double t_old, double t_new, double mass_old, double mass_new);
 
+/** @brief The threshold of the watched quantity (age or mass) at which a
+ *         cell with birth record @p birth divides. */
+double sp_division_threshold(const sp_division_params *params, const sp_cell_birth *birth);
+
 /**
  * @brief Fraction theta of the step t_old -> t_new at which the division
  *        threshold is crossed, so the caller can redo the step with theta dt

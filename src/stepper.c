@@ -444,6 +444,38 @@ static void report_failure(const sp_run *run, int step, double t, double dt, con
   else fprintf(stderr, "; retried with dt = %.3g\n", run->dtc.dt_next);
 }
 
+/** Adaptive control, mass criterion: a step whose end overshoots a cell's
+ *  division mass by more than this (relative) is redone, shortened to the
+ *  interpolated crossing (sp_division_crossing_fraction); a landing within
+ *  it counts as the crossing (sp_division_params.tolerance). */
+#define SP_MASS_LANDING_TOLERANCE 1e-3
+
+/** The fraction of the step just solved (run->state_old -> run->state,
+ *  observables of c^n in run->obs) at which the first mass division due
+ *  in it was reached, when the step overshot it by more than
+ *  SP_MASS_LANDING_TOLERANCE; 1 otherwise. */
+static int mass_crossing(sp_run *run, double t_old, double t_new, double *theta) {
+  *theta = 1.0;
+  const int n = run->layout->n_cells;
+  if (n >= run->n_max) return SP_OK;
+  sp_cell_obs *obs;
+  SP_ALLOC(obs, n);
+  int rc = sp_cells_observe(run->mesh, run->layout, run->state,
+                            run->scene->division.observe_threshold, obs);
+  for (int k = 0; k < n && rc == SP_OK; ++k) {
+    const double m_old = run->obs[k].mass_core, m_new = obs[k].mass_core;
+    if (!sp_division_due(&run->division, &run->birth[k], t_old, t_new, m_old, m_new)) continue;
+    const double f = sp_division_crossing_fraction(&run->division, &run->birth[k], t_old, t_new,
+                                                   m_old, m_new);
+    /* overshot: past the threshold by more than the tolerance */
+    const double over = m_new - sp_division_threshold(&run->division, &run->birth[k]) *
+                                    (1 + SP_MASS_LANDING_TOLERANCE);
+    if (f > 0 && f < 1 && over > 0) *theta = fmin(*theta, f);
+  }
+  free(obs);
+  return rc;
+}
+
 /** The time loop proper. */
 static int run_steps(sp_run *run, sp_run_summary *sum) {
   const sp_scene_time *tc = &run->scene->time;
@@ -524,6 +556,16 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     else if (sp_dt_judge(&run->dtc, dt_try, err) == SP_DT_REJECT) {
       solved = 1; /* never accepted: retried with a smaller step */
       give_up = sp_dt_give_up(&run->dtc);
+    } else if (adaptive && run->scene->division.criterion == SP_DIVIDE_BY_MASS) {
+      double theta;
+      rc = mass_crossing(run, t, t + dt_try, &theta);
+      if (rc != SP_OK) break;
+      if (theta < 1) { /* land on the crossing: redo the step shorter */
+        run->dtc.dt_next = fmax(theta * dt_try, tc->dt_min);
+        why = "a cell's mass passed its division mass inside the step (landing on it)";
+        err = -1.0;
+        solved = 1;
+      }
     }
     if (solved == 1) { /* retry from the last good state */
       memcpy(run->state, run->state_old, n_values * sizeof(double));
@@ -531,7 +573,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       ++sum->failed_attempts;
       seconds.failed_factorisations += report.factorisations;
       sum->failed_factorisations += report.factorisations;
-      report_failure(run, step, t, dt_try, why, err < 0 ? &report : NULL, give_up);
+      report_failure(run, step, t, dt_try, why, err < 0 && report.reason[0] ? &report : NULL,
+                     give_up);
       if (give_up) {
         int rc_out = write_snapshot(run, step, t);
         rc = sp_error_set(SP_ERR_SOLVER,
@@ -743,7 +786,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
       .criterion = dv->criterion == SP_DIVIDE_BY_AGE ? SP_DIVIDE_AGE : SP_DIVIDE_MASS,
       .age = dv->t_div, .mass_ratio = dv->mass_ratio,
       .reference_mass = dv->use_initial_mass ? run->birth[0].birth_mass : 0.0,
-      .tolerance = 0.0};
+      .tolerance = scene->time.control == SP_CONTROL_ADAPTIVE ? SP_MASS_LANDING_TOLERANCE : 0.0};
   return SP_OK;
 }
 
