@@ -11,6 +11,7 @@
  *
  * Exit status: 0 success, 2 bad input (nothing written), 1 any other failure.
  */
+#include <dlfcn.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -99,8 +100,22 @@ static int cmd_run(int argc, char **argv, int rank) {
   return rc;
 }
 
+/** One thread per process unless the user set OMP_NUM_THREADS: Debian's
+ *  SuperLU_DIST (OpenMP) and OpenBLAS (its own threads) otherwise start a
+ *  thread per core in every MPI process, which oversubscribes the cores and
+ *  slowed SuperLU_DIST several-fold (docs/benchmarks.md). Looked up at run
+ *  time: neither library is a link dependency of the program. */
+static void hold_threads(void) {
+  if (getenv("OMP_NUM_THREADS")) return;
+  void (*set_omp)(int) = (void (*)(int))dlsym(RTLD_DEFAULT, "omp_set_num_threads");
+  if (set_omp) set_omp(1);
+  void (*set_blas)(int) = (void (*)(int))dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
+  if (set_blas) set_blas(1);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
+  hold_threads();
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   int rc = SP_OK;
