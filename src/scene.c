@@ -245,20 +245,20 @@ static const sp_key sp_keys[] = {
     KEY_FLOAT(SP_SEC_MODEL, "mobility", model.mobility, 1.0, ABOVE(0.0),
               UNBOUNDED, "L^2/(E T)", "Cahn-Hilliard mobility M"),
     /* time */
-    KEY_ENUM(SP_SEC_TIME, "control", time.control, SP_CONTROL_FIXED,
+    KEY_ENUM(SP_SEC_TIME, "control", time.control, SP_CONTROL_ADAPTIVE,
              sp_control_words, "-",
              "how dt is chosen: fixed (the paper's: dt, shrunk after a failed "
              "Newton solve, algorithm 2 after a division) or adaptive (from a "
              "local error estimate of c against rtol and atol; "
              "docs/time-stepping.md)"),
-    KEY_ENUM(SP_SEC_TIME, "scheme", time.scheme, SP_TIME_BE,
+    KEY_ENUM(SP_SEC_TIME, "scheme", time.scheme, SP_TIME_BDF2,
              sp_time_scheme_words, "-",
              "time scheme: backward Euler (be, the paper's) or variable-step "
              "BDF2 (bdf2, second order; BE after the start and each "
              "division)"),
-    KEY_FLOAT(SP_SEC_TIME, "rtol", time.rtol, 1e-3, ABOVE(0.0), UNBOUNDED, "-",
+    KEY_FLOAT(SP_SEC_TIME, "rtol", time.rtol, 1e-2, ABOVE(0.0), UNBOUNDED, "-",
               "adaptive: relative tolerance of a step's local error in c"),
-    KEY_FLOAT(SP_SEC_TIME, "atol", time.atol, 1e-3, ABOVE(0.0), UNBOUNDED, "-",
+    KEY_FLOAT(SP_SEC_TIME, "atol", time.atol, 1e-2, ABOVE(0.0), UNBOUNDED, "-",
               "adaptive: absolute tolerance of a step's local error in c"),
     KEY_FLOAT(SP_SEC_TIME, "dt_max", time.dt_max, 1.0, ABOVE(0.0), UNBOUNDED,
               "T", "adaptive: the largest step (must be >= dt_min)"),
@@ -301,7 +301,7 @@ static const sp_key sp_keys[] = {
              sp_jacobian_words, "-",
              "Newton Jacobian: automatic differentiation, hand-coded or "
              "finite differences"),
-    KEY_ENUM(SP_SEC_SOLVER, "linear", solver.linear, SP_LINEAR_SUPERLU,
+    KEY_ENUM(SP_SEC_SOLVER, "linear", solver.linear, SP_LINEAR_MUMPS,
              sp_linear_words, "-",
              "linear solver of each Newton step: direct (superlu, "
              "superlu_dist, mumps, klu2) or GMRES with an ILU(k) "
@@ -316,7 +316,7 @@ static const sp_key sp_keys[] = {
             AT_LEAST(1), AT_MOST(60), "-",
             "Newton iterations (with jacobian_reuse: factorisations, and at "
             "most twice as many iterations) before a step counts as failed"),
-    KEY_FLOAT(SP_SEC_SOLVER, "jacobian_reuse", solver.jacobian_reuse, 0.0,
+    KEY_FLOAT(SP_SEC_SOLVER, "jacobian_reuse", solver.jacobian_reuse, 0.1,
               AT_LEAST(0.0), BELOW(1.0), "-",
               "modified Newton: an iteration keeps the last Jacobian and its "
               "factorisation while the previous one cut the residual norm by "
@@ -352,7 +352,7 @@ static const sp_key sp_keys[] = {
               "gmres_ilu: a linear solve ends when its residual is below this "
               "fraction of the right-hand side's norm (a solve not there in "
               "500 iterations fails the Newton attempt)"),
-    KEY_ENUM(SP_SEC_SOLVER, "predictor", solver.predictor, SP_PREDICT_NONE,
+    KEY_ENUM(SP_SEC_SOLVER, "predictor", solver.predictor, SP_PREDICT_LINEAR,
              sp_predictor_words, "-",
              "Newton's initial guess: the last state (none) or the last state "
              "plus its last increment x min(dt / dt_last, 2) (linear; not "
@@ -1136,6 +1136,12 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
            "%s: time.dt_min: expected a number <= time.dt = %.15g, got "
            "%.15g",
            file, t->dt, t->dt_min);
+  SP_CHECK(!(t->scheme == SP_TIME_BDF2 && scene->shape.scheme == SP_SHAPE_IMPLICIT &&
+             (scene->shape.delta1 > 0 || scene->shape.delta2 > 0)),
+           SP_ERR_INPUT,
+           "%s: time.scheme: expected be with shape.scheme implicit (its linearised moments "
+           "need c^n, which a BDF2 step does not solve from), got bdf2",
+           file);
   SP_CHECK(t->dt_max >= t->dt_min, SP_ERR_INPUT,
            "%s: time.dt_max: expected a number >= time.dt_min = %.15g, got %.15g", file,
            t->dt_min, t->dt_max);

@@ -51,7 +51,7 @@ done
 scene=$prefix/share/softpack/inputs/default.yaml
 facts=$("$tmp/examples/scene_facts" "$scene")
 echo "$facts"
-grep -q "^mesh: ellipse, 1408 elements, 1441 nodes" <<< "$facts" || fail "mesh facts"
+grep -q "^mesh: ellipse, 5376 elements, 5441 nodes" <<< "$facts" || fail "mesh facts"
 grep -q "^cells: 3$" <<< "$facts" || fail "cell count"
 grep -q "^  cell 1 at (-0.2, 0), radius 0.13$" <<< "$facts" || fail "first cell"
 status=0
