@@ -45,6 +45,8 @@
 #include <string.h>
 
 #include "error.h"
+#include "layout.h"
+#include "mesh.h"
 
 /* ------------------------------------------------------------------------ */
 /* The key table                                                            */
@@ -1174,6 +1176,31 @@ static int check_cells(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
+/** The initial layout (every cell on every node: a run starts with it, also
+ *  before cutting local supports) must be numberable by ints and Epetra's
+ *  32-bit global ids; checked here, before anything that large is allocated. */
+static int check_sizes(const sp_scene *scene, const char *file) {
+  const sp_scene_mesh *m = &scene->mesh;
+  const int rectangle = m->type == SP_MESH_RECTANGLE;
+  const long long nodes = rectangle ? sp_mesh_rectangle_nodes(m->nx, m->ny)
+                                    : sp_mesh_ellipse_nodes(m->refinements, m->buffer_layers);
+  const long long pairs = nodes * scene->n_cells;
+  char mesh_keys[SP_TEXT];
+  if (rectangle)
+    snprintf(mesh_keys, sizeof mesh_keys, "mesh.nx, mesh.ny (%d x %d elements)", m->nx, m->ny);
+  else
+    snprintf(mesh_keys, sizeof mesh_keys,
+             "mesh.refinements, mesh.buffer_layers (%d refinements, %d buffer layers)",
+             m->refinements, m->buffer_layers);
+  SP_CHECK(pairs <= SP_LAYOUT_MAX_PAIRS, SP_ERR_INPUT,
+           "%s: %s and cells (%d cells): too large: %lld nodes x %d cells = %lld (cell, node) "
+           "pairs in the initial layout, 2 x %lld unknowns; at most %d pairs fit the "
+           "solver's 32-bit indices (Epetra's global ids): use fewer elements or cells",
+           file, mesh_keys, scene->n_cells, nodes, scene->n_cells, pairs, pairs,
+           SP_LAYOUT_MAX_PAIRS);
+  return SP_OK;
+}
+
 /* ------------------------------------------------------------------------ */
 /* Public functions                                                         */
 /* ------------------------------------------------------------------------ */
@@ -1191,6 +1218,7 @@ static int fill_scene(sp_scene *scene, const char *path, int n_set,
            n_set ? " (with its --set overrides)" : "");
   SP_CALL(check_time_and_mesh(scene, where));
   SP_CALL(check_cells(scene, where));
+  SP_CALL(check_sizes(scene, where));
   return SP_OK;
 }
 

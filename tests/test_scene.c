@@ -7,7 +7,10 @@
  *   containing the key named in its first line, "# expect: <key>";
  * - missing, unreadable and empty files fail the same way;
  * - docs/scene.md holds exactly the table sp_scene_print_keys prints;
- * - every scene shipped under inputs/ and inputs/paper/ loads. */
+ * - every scene shipped under inputs/ and inputs/paper/ loads;
+ * - a scene whose initial layout (nodes x cells pairs, 2 x pairs unknowns)
+ *   would overflow 32-bit indices is refused, one just below the limit is
+ *   not. */
 #define _POSIX_C_SOURCE 200809L /* opendir, readdir */
 
 #include <dirent.h>
@@ -334,8 +337,26 @@ static void test_shipped_scenes(void) {
   CHECK(n >= 11, "only %d scenes under inputs/", n);
 }
 
+/* tests/scenes/bad/too_many_pairs.yaml: 64 cells on a rectangle. The limit is
+ * 2^30 - 1 pairs: (4094+1)(4096+1) x 64 = (2^24 - 1) x 64 = 2^30 - 64 fits,
+ * (4095+1)(4096+1) x 64 = 2^30 + 2^18 does not. Loading a scene builds no
+ * mesh, so the accepted one costs nothing here. */
+static void test_sizes(void) {
+  char path[PATH_SIZE];
+  source_path("tests/scenes/bad/too_many_pairs.yaml", path);
+  const char *fits[] = {"mesh.nx=4094"}, *too_large[] = {"mesh.nx=4095"};
+  sp_scene *s = NULL;
+  CHECK(sp_scene_load(path, 1, fits, &s) == SP_OK, "nx = 4094: %s", sp_error_message());
+  CHECK(s && s->n_cells == 64 && s->mesh.nx == 4094 && s->mesh.ny == 4096,
+        "the scene with nx = 4094 was not loaded as written");
+  sp_scene_destroy(&s);
+  expect_input_error(path, 1, too_large, "mesh.nx", "64 cells");
+  expect_input_error(path, 0, NULL, "mesh.ny", "64 cells");
+}
+
 int main(void) {
   test_shipped_scenes();
+  test_sizes();
   test_defaults();
   test_every_key();
   test_overrides();
