@@ -1022,10 +1022,9 @@ static int apply_raw(sp_scene *scene, const sp_raw_scene *raw,
   return SP_OK;
 }
 
-static int load_file(sp_scene *scene, const char *path) {
-  char *text = NULL;
-  size_t len = 0;
-  SP_CALL(read_file(path, &text, &len));
+/** The values of a scene file's text; @p name is the file in messages. */
+static int load_text(sp_scene *scene, const char *name, const char *text,
+                     size_t len) {
   sp_schema schema;
   build_schema(&schema);
   sp_cyaml_log log = {.n = 0};
@@ -1035,15 +1034,23 @@ static int load_file(sp_scene *scene, const char *path) {
   if (len > 0)
     err = cyaml_load_data((const uint8_t *)text, len, &config, &schema.top,
                           (cyaml_data_t **)&raw, NULL);
-  free(text);
-  if (err != CYAML_OK) return report_cyaml_error(path, err, &log);
+  if (err != CYAML_OK) return report_cyaml_error(name, err, &log);
   /* an empty file, or only comments: libcyaml succeeds with no data */
   SP_CHECK(raw, SP_ERR_INPUT,
            "%s: cells: missing; the file holds no YAML document (empty or "
            "only comments) and a scene needs at least one cell",
-           path);
-  int rc = apply_raw(scene, raw, path);
+           name);
+  int rc = apply_raw(scene, raw, name);
   cyaml_free(&config, &schema.top, raw, 0);
+  return rc;
+}
+
+static int load_file(sp_scene *scene, const char *path) {
+  char *text = NULL;
+  size_t len = 0;
+  SP_CALL(read_file(path, &text, &len));
+  int rc = load_text(scene, path, text, len);
+  free(text);
   return rc;
 }
 
@@ -1205,12 +1212,13 @@ static int check_sizes(const sp_scene *scene, const char *file) {
 /* Public functions                                                         */
 /* ------------------------------------------------------------------------ */
 
-/** Everything sp_scene_load does to a zeroed scene; the caller frees it on
- *  failure, so this may return from anywhere. */
-static int fill_scene(sp_scene *scene, const char *path, int n_set,
-                      const char *const *set) {
+/** Everything sp_scene_load does to a zeroed scene, from the file @p path
+ *  or, when @p text is not NULL, from @p text standing for it; the caller
+ *  frees the scene on failure, so this may return from anywhere. */
+static int fill_scene(sp_scene *scene, const char *path, const char *text,
+                      size_t len, int n_set, const char *const *set) {
   for (int s = 0; s < SP_SEC_CELLS; ++s) store_defaults(scene, (sp_section)s);
-  SP_CALL(load_file(scene, path));
+  SP_CALL(text ? load_text(scene, path, text, len) : load_file(scene, path));
   for (int i = 0; i < n_set; ++i) SP_CALL(apply_override(scene, set[i]));
   /* a clash may come from an override: say so in the prefix */
   char where[SP_TEXT + SP_TEXT];
@@ -1222,20 +1230,31 @@ static int fill_scene(sp_scene *scene, const char *path, int n_set,
   return SP_OK;
 }
 
-int sp_scene_load(const char *path, int n_set, const char *const *set,
-                  sp_scene **out) {
+static int load_scene(const char *path, const char *text, size_t len,
+                      int n_set, const char *const *set, sp_scene **out) {
   SP_CHECK(path && out && n_set >= 0 && (n_set == 0 || set), SP_ERR_INTERNAL,
            "sp_scene_load: bad arguments");
   *out = NULL;
   sp_scene *scene;
   SP_ALLOC(scene, 1);
-  int rc = fill_scene(scene, path, n_set, set);
+  int rc = fill_scene(scene, path, text, len, n_set, set);
   if (rc != SP_OK) {
     sp_scene_destroy(&scene);
     return rc;
   }
   *out = scene;
   return SP_OK;
+}
+
+int sp_scene_load(const char *path, int n_set, const char *const *set,
+                  sp_scene **out) {
+  return load_scene(path, NULL, 0, n_set, set, out);
+}
+
+int sp_scene_load_text(const char *name, const char *text, size_t len,
+                       int n_set, const char *const *set, sp_scene **out) {
+  SP_CHECK(text || len == 0, SP_ERR_INTERNAL, "sp_scene_load_text: no text");
+  return load_scene(name, text ? text : "", len, n_set, set, out);
 }
 
 double sp_scene_interface_width(const sp_scene *scene) {

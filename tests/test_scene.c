@@ -8,6 +8,8 @@
  * - missing, unreadable and empty files fail the same way;
  * - docs/scene.md holds exactly the table sp_scene_print_keys prints;
  * - every scene shipped under inputs/ and inputs/paper/ loads;
+ * - sp_scene_load_text reads text as sp_scene_load reads the file, and
+ *   names the given name in its messages;
  * - a scene whose initial layout (nodes x cells pairs, 2 x pairs unknowns)
  *   would overflow 32-bit indices is refused, one just below the limit is
  *   not. */
@@ -354,8 +356,53 @@ static void test_sizes(void) {
   expect_input_error(path, 0, NULL, "mesh.ny", "64 cells");
 }
 
+/* The scene reader from memory (what the fuzz target feeds): the same
+ * scene as from the file, and the same errors under the given name. */
+static void test_load_text(void) {
+  char path[PATH_SIZE];
+  source_path("tests/scenes/ellipse_minimal.yaml", path);
+  FILE *f = fopen(path, "rb");
+  CHECK(f, "cannot open %s", path);
+  if (!f) return;
+  char *text = slurp(f);
+  fclose(f);
+  CHECK(text, "cannot read %s", path);
+  if (!text) return;
+  /* the text in a buffer of exactly its length, no NUL after it (an
+   * over-read shows under tools/softpack.sh sanitize) */
+  const size_t len = strlen(text);
+  char *exact = malloc(len);
+  CHECK(exact, "out of memory");
+  if (!exact) return;
+  memcpy(exact, text, len);
+  sp_scene *from_file = NULL, *from_text = NULL;
+  CHECK_OK(sp_scene_load(path, 0, NULL, &from_file));
+  CHECK_OK(sp_scene_load_text("memory.yaml", exact, len, 0, NULL, &from_text));
+  CHECK(from_text->n_cells == from_file->n_cells && from_text->n_cells == 2, "%d cells",
+        from_text->n_cells);
+  for (int c = 0; c < 2 && from_text->n_cells == 2; ++c) {
+    const sp_scene_cell *a = &from_text->cells[c], *b = &from_file->cells[c];
+    CHECK(a->x == b->x && a->y == b->y && a->radius == b->radius && a->profile == b->profile,
+          "cells[%d] differs", c);
+  }
+  CHECK_NEAR(from_text->model.lambda, 80.0, 0.0);
+  CHECK(from_text->mesh.refinements == from_file->mesh.refinements, "refinements %d",
+        from_text->mesh.refinements);
+  sp_scene_destroy(&from_file);
+  sp_scene_destroy(&from_text);
+  free(exact);
+  free(text);
+  static const char bad[] = "model: {lambda: -1}\ncells: [{x: 0, y: 0, radius: 0.05}]\n";
+  CHECK(sp_scene_load_text("memory.yaml", bad, sizeof bad - 1, 0, NULL, &from_text) ==
+            SP_ERR_INPUT && !from_text,
+        "a bad scene from memory: %s", sp_error_message());
+  CHECK(strstr(sp_error_message(), "memory.yaml") && strstr(sp_error_message(), "model.lambda"),
+        "message: %s", sp_error_message());
+}
+
 int main(void) {
   test_shipped_scenes();
+  test_load_text();
   test_sizes();
   test_defaults();
   test_every_key();
