@@ -4,7 +4,8 @@
 #                            inputs/default.yaml into out/default/ (pictures too)
 #   tools/softpack.sh test   install what is missing, build, run every test (ctest)
 #   tools/softpack.sh valgrind   memcheck on a bad-input run and a short real run
-#                                (docs/robustness.md)
+#   tools/softpack.sh fuzz [SECONDS]   libFuzzer on the scene reader (default 600 s)
+#   (these two: docs/robustness.md)
 # Everything comes from Debian's archive; nothing is downloaded otherwise.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -81,8 +82,27 @@ case "${1:-}" in
       --set time.max_steps=2 --set mesh.nx=40 --set mesh.ny=24 --out "$tmp/run"
     echo "softpack: valgrind: both runs clean"
     ;;
+  fuzz)
+    seconds=${2:-600}
+    install_missing clang libclang-rt-14-dev
+    CC=clang CXX=clang++ cmake -S . -B build-fuzz -DSOFTPACK_FUZZ=ON \
+      -DCMAKE_BUILD_TYPE=RelWithDebInfo
+    cmake --build build-fuzz -j 2
+    # seeds: every scene of the repository, the broken ones and the kept
+    # fuzz findings included; the corpus grows in build-fuzz/corpus
+    rm -rf build-fuzz/seeds
+    mkdir -p build-fuzz/seeds build-fuzz/corpus build-fuzz/crashes
+    find inputs tests/scenes -type f -name '*.yaml' | while read -r f; do
+      cp "$f" "build-fuzz/seeds/$(echo "$f" | tr / _)"
+    done
+    # one process; a finding stops the run and is written to build-fuzz/crashes/
+    # (keep it under tests/scenes/fuzz/, where test_fuzz_regressions loads it)
+    nice -n 19 build-fuzz/fuzz_scene -max_total_time="$seconds" -timeout=10 \
+      -rss_limit_mb=2048 -print_final_stats=1 -dict=tests/fuzz/scene.dict \
+      -artifact_prefix=build-fuzz/crashes/ build-fuzz/corpus build-fuzz/seeds
+    ;;
   *)
-    echo "usage: tools/softpack.sh demo|test|valgrind" >&2
+    echo "usage: tools/softpack.sh demo|test|valgrind|fuzz [SECONDS]" >&2
     exit 2
     ;;
 esac
