@@ -947,6 +947,20 @@ static int report_cyaml_error(const char *file, cyaml_err_t err,
   if (err == CYAML_ERR_INVALID_ALIAS || err == CYAML_ERR_ALIAS)
     return sp_error_set(SP_ERR_INPUT, "%s: %s: bad YAML alias (libcyaml: %s)",
                         at, path, message);
+  if (err == CYAML_ERR_INTERNAL_ERROR) {
+    /* libcyaml 1.3.1 says "internal error" for an event its state has no
+     * handler for, which input can cause: a key that is itself a mapping
+     * or a sequence, "{x: 1, y}: 2" (tests/scenes/fuzz/). The backtrace's
+     * innermost field is the last one read, not the bad key. */
+    backtrace_where(log, 1, &where);
+    path = where.path[0] ? where.path : "top level";
+    return sp_error_set(SP_ERR_INPUT,
+                        "%s: %s: expected %s; libcyaml cannot read what follows "
+                        "there (a key that is a mapping or a sequence?) (libcyaml: %s)",
+                        file_line(file, where.line, at, sizeof at), path,
+                        path_expectation(where.path, expected, sizeof expected),
+                        cyaml_strerror(err));
+  }
   /* anything else is a schema or library problem, not the user's */
   return sp_error_set(SP_ERR_INTERNAL, "%s: libcyaml failed (%s): %s", file,
                       cyaml_strerror(err), message);
