@@ -93,7 +93,8 @@ case "${1:-}" in
     # the slow unwinder records whole allocation stacks, so that a leak made
     # in an Open MPI component (dlclose'd before the leak check) still shows
     # the libmpi frames below it
-    export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:strict_string_checks=1:fast_unwind_on_malloc=0
+    export ASAN_OPTIONS=abort_on_error=1:detect_leaks=1:strict_string_checks=1
+    ASAN_OPTIONS+=:fast_unwind_on_malloc=0
     export UBSAN_OPTIONS=halt_on_error=1:abort_on_error=1:print_stacktrace=1
     export LSAN_OPTIONS=suppressions=$PWD/tools/lsan.supp:print_suppressions=0
     cd build-sanitize && ctest -L fast --output-on-failure
