@@ -324,10 +324,10 @@ static const sp_key sp_keys[] = {
              "solve (SuperLU_DIST's default; off: solves cost a third, and "
              "the paper's run 5 and the aggregate take the same Newton "
              "iterations to the same energies within 1e-15)"),
-    KEY_INT(SP_SEC_SOLVER, "ilu_fill", solver.ilu_fill, 2, AT_LEAST(1), AT_MOST(20), "-",
+    KEY_INT(SP_SEC_SOLVER, "ilu_fill", solver.ilu_fill, 2, AT_LEAST(0), AT_MOST(20), "-",
             "gmres_ilu: level of fill of the incomplete LU preconditioner "
-            "(ILU(k); 1 stalls on these matrices, 2 is the cheapest that "
-            "converges well)"),
+            "(ILU(k), 0: no fill; 1 stalls on these matrices, 2 is the "
+            "cheapest that converges well)"),
     KEY_FLOAT(SP_SEC_SOLVER, "krylov_tol", solver.krylov_tol, 1e-10, ABOVE(0.0), AT_MOST(1e-3),
               "-",
               "gmres_ilu: a linear solve ends when its residual is below this "

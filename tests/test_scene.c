@@ -211,7 +211,7 @@ static void test_overrides(void) {
       {"cells.x=0", "cells.x"},                /* cells are file only */
       {"time.dt=1e-15", "time.dt_min"},        /* cross-key: dt_min > dt */
       {"solver.newton_divergence=0.5", "solver.newton_divergence"}, /* 0 or > 1 */
-      {"solver.ilu_fill=0", "solver.ilu_fill"},       /* ILU(k), k >= 1 */
+      {"solver.ilu_fill=-1", "solver.ilu_fill"},      /* ILU(k), k >= 0 */
       {"solver.krylov_tol=0.5", "solver.krylov_tol"}, /* at most 1e-3 */
       {"mesh.semi_y=0.1", "cells[1].radius"},  /* cells no longer fit */
   };
