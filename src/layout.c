@@ -31,8 +31,13 @@ int sp_layout_create_from_masks(int n_nodes, int n_cells,
   l->n_nodes = n_nodes;
   l->n_cells = n_cells;
   l->n_pairs = (int)count;
-  SP_ALLOC(l->node_start, (size_t)n_nodes + 1);
-  SP_ALLOC(l->pair_cell, (size_t)count);
+  l->node_start = calloc((size_t)n_nodes + 1, sizeof *l->node_start);
+  l->pair_cell = calloc(count ? (size_t)count : 1, sizeof *l->pair_cell);
+  if (!l->node_start || !l->pair_cell) {
+    sp_layout_destroy(&l);
+    return sp_error_set(SP_ERR_MEMORY, "layout: out of memory for %lld (cell, node) pairs",
+                        (long long)count);
+  }
   int p = 0;
   for (int i = 0; i < n_nodes; ++i) {
     l->node_start[i] = p;
