@@ -72,8 +72,10 @@ typedef struct {
   /** SuperLU_DIST only: 1 for one step of iterative refinement per solve
    *  (SuperLU_DIST's default), 0 for none. */
   int refine;
-  /** SP_SOLVER_GMRES_ILU only: the ILU(k) level of fill (0 = 2) and the
-   *  relative residual of a linear solve (0 = 1e-10). */
+  /** SP_SOLVER_GMRES_ILU only, taken as given (no defaults here: the
+   *  scene's solver.ilu_fill and solver.krylov_tol have them): the ILU(k)
+   *  level of fill, >= 0 (0: ILU(0)), and the relative residual of a
+   *  linear solve, in (0, 1). */
   int ilu_fill;
   double krylov_tol;
 } sp_solver_options;

@@ -72,12 +72,13 @@ std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, 
 // "Amesos_Klu". Throws if Amesos was built without it.
 std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &which);
 // GMRES preconditioned by ILU(fill) (additive Schwarz across ranks), to a
-// residual of tolerance x |b|.
+// residual of tolerance x |b|. fill and tolerance come from the caller
+// (the scene's solver.ilu_fill and solver.krylov_tol hold the defaults).
 struct KrylovOptions {
-  int fill = 2;
+  int fill = -1;
   int restart = 100;
   int max_iterations = 500;
-  double tolerance = 1e-10;
+  double tolerance = 0;
 };
 std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options);
 

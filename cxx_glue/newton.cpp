@@ -18,6 +18,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -237,12 +238,17 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       direct_ = make_amesos(comm, "Amesos_Klu");
       break;
     case SP_SOLVER_GMRES_ILU: {
+      // taken as given: 0 is ILU(0), not a default (the scene has those)
       KrylovOptions k;
-      if (options.ilu_fill != 0) k.fill = options.ilu_fill;
-      if (options.krylov_tol != 0) k.tolerance = options.krylov_tol;
-      if (k.fill < 0 || !(k.tolerance > 0 && k.tolerance < 1))
+      k.fill = options.ilu_fill;
+      k.tolerance = options.krylov_tol;
+      if (k.fill < 0 || !(k.tolerance > 0 && k.tolerance < 1)) {
+        char got[96];
+        std::snprintf(got, sizeof got, "%d and %g", k.fill, k.tolerance);
         throw std::runtime_error(
-            "solver.ilu_fill / krylov_tol: expected fill >= 0 and 0 < tol < 1");
+            std::string("solver.ilu_fill / krylov_tol: expected fill >= 0 and 0 < tol < 1, got ") +
+            got);
+      }
       direct_ = make_krylov(comm, k);
       break;
     }

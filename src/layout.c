@@ -1,8 +1,19 @@
 #include "layout.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "error.h"
+
+/** SP_OK if a layout of @p count pairs can be numbered (SP_LAYOUT_MAX_PAIRS). */
+static int check_pair_count(int64_t count, int n_nodes, int n_cells) {
+  SP_CHECK(count <= SP_LAYOUT_MAX_PAIRS, SP_ERR_MEMORY,
+           "layout: %lld (cell, node) pairs (%d cells on %d nodes), more than %d: "
+           "their 2 x pairs unknowns would overflow the solver's 32-bit indices "
+           "(Epetra's global ids)",
+           (long long)count, n_cells, n_nodes, SP_LAYOUT_MAX_PAIRS);
+  return SP_OK;
+}
 
 int sp_layout_create_from_masks(int n_nodes, int n_cells,
                                 const unsigned char *in_support,
@@ -11,16 +22,22 @@ int sp_layout_create_from_masks(int n_nodes, int n_cells,
            "layout needs nodes (got %d) and a cell count >= 0 (got %d)",
            n_nodes, n_cells);
   sp_layout *l;
-  SP_ALLOC(l, 1);
-  l->n_nodes = n_nodes;
-  l->n_cells = n_cells;
-  SP_ALLOC(l->node_start, n_nodes + 1);
-  long count = 0;
+  int64_t count = 0;
   for (int i = 0; i < n_nodes; ++i)
     for (int k = 0; k < n_cells; ++k)
       count += in_support[(size_t)k * n_nodes + i] != 0;
+  SP_CALL(check_pair_count(count, n_nodes, n_cells));
+  SP_ALLOC(l, 1);
+  l->n_nodes = n_nodes;
+  l->n_cells = n_cells;
   l->n_pairs = (int)count;
-  SP_ALLOC(l->pair_cell, count);
+  l->node_start = calloc((size_t)n_nodes + 1, sizeof *l->node_start);
+  l->pair_cell = calloc(count ? (size_t)count : 1, sizeof *l->pair_cell);
+  if (!l->node_start || !l->pair_cell) {
+    sp_layout_destroy(&l);
+    return sp_error_set(SP_ERR_MEMORY, "layout: out of memory for %lld (cell, node) pairs",
+                        (long long)count);
+  }
   int p = 0;
   for (int i = 0; i < n_nodes; ++i) {
     l->node_start[i] = p;
@@ -33,6 +50,7 @@ int sp_layout_create_from_masks(int n_nodes, int n_cells,
 }
 
 int sp_layout_create_full(int n_nodes, int n_cells, sp_layout **out) {
+  SP_CALL(check_pair_count((int64_t)n_nodes * n_cells, n_nodes, n_cells));
   unsigned char *mask;
   SP_ALLOC(mask, (size_t)n_nodes * (n_cells ? n_cells : 1));
   for (size_t i = 0; i < (size_t)n_nodes * n_cells; ++i) mask[i] = 1;

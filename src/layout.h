@@ -13,9 +13,16 @@
 #ifndef SP_LAYOUT_H
 #define SP_LAYOUT_H
 
+#include <limits.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/** The most (cell, node) pairs a layout may have: pairs, their 2 x pairs
+ *  unknowns (state[2p + 1]) and the solver's global ids (Epetra's are
+ *  32-bit ints) are all ints. */
+#define SP_LAYOUT_MAX_PAIRS (INT_MAX / 2)
 
 typedef struct sp_layout {
   int n_nodes;
@@ -31,6 +38,8 @@ int sp_layout_create_full(int n_nodes, int n_cells, sp_layout **out);
 /**
  * @brief A layout from per-cell node masks: in_support[k * n_nodes + i] != 0
  *        when node i is in cell k's support.
+ * @return SP_OK, or SP_ERR_MEMORY when the masks hold more than
+ *         SP_LAYOUT_MAX_PAIRS pairs
  */
 int sp_layout_create_from_masks(int n_nodes, int n_cells,
                                 const unsigned char *in_support,

@@ -53,6 +53,27 @@ static void default_out_dir(const char *scene_path, char *out, size_t size) {
   snprintf(out, size, "out/%.*s", (int)len, base);
 }
 
+/** The run's summary lines on stdout. */
+static void print_summary(const sp_run_summary *sum, const char *out_dir) {
+  if (sum->layout_changes)
+    printf("softpack: local supports: %d changes (%.1f s), largest relative mass change restored "
+           "%.2e, mass dropped in all %.2e of the total, largest relative energy rise at a change "
+           "%.2e, at most %ld unknowns\n",
+           sum->layout_changes, sum->t_layout, sum->support_mass_correction,
+           sum->support_mass_dropped, sum->support_energy_rise, sum->unknowns_max);
+  else
+    printf("softpack: at most %ld unknowns per step\n", sum->unknowns_max);
+  char gmres[64] = "";
+  if (sum->linear_its > 0)
+    snprintf(gmres, sizeof gmres, "; %ld GMRES iterations", sum->linear_its);
+  printf("softpack: %d steps to t = %.6g (%d failed attempts retried, smallest dt %.3g), "
+         "%ld Newton iterations (%ld factorisations, and %ld in failed attempts%s), %.1f s "
+         "(assembly %.1f, factorisation %.1f, solves %.1f); output in %s\n",
+         sum->steps, sum->t_final, sum->failed_attempts, sum->dt_smallest, sum->newton_its,
+         sum->factorisations, sum->failed_factorisations, gmres, sum->wall_seconds,
+         sum->t_assembly, sum->t_factor, sum->t_solve, out_dir);
+}
+
 static int cmd_run(int argc, char **argv, int rank) {
   const char *scene_path = NULL, *out_dir = NULL;
   const char **sets = calloc(argc > 0 ? argc : 1, sizeof(char *));
@@ -75,26 +96,10 @@ static int cmd_run(int argc, char **argv, int rank) {
   }
   sp_scene *scene = NULL;
   if (rc == SP_OK) rc = sp_scene_load(scene_path, n_set, sets, &scene);
-  sp_run_summary sum;
+  sp_run_summary sum = {0};
   if (rc == SP_OK) rc = sp_stepper_run(scene, out_dir, MPI_COMM_WORLD, &sum);
-  if (rc == SP_OK && rank == 0 && sum.layout_changes)
-    printf("softpack: local supports: %d changes (%.1f s), largest relative mass change restored "
-           "%.2e, mass dropped in all %.2e of the total, largest relative energy rise at a change "
-           "%.2e, at most %ld unknowns\n",
-           sum.layout_changes, sum.t_layout, sum.support_mass_correction,
-           sum.support_mass_dropped, sum.support_energy_rise, sum.unknowns_max);
-  else if (rc == SP_OK && rank == 0)
-    printf("softpack: at most %ld unknowns per step\n", sum.unknowns_max);
-  char gmres[64] = "";
-  if (sum.linear_its > 0)
-    snprintf(gmres, sizeof gmres, "; %ld GMRES iterations", sum.linear_its);
-  if (rc == SP_OK && rank == 0)
-    printf("softpack: %d steps to t = %.6g (%d failed attempts retried, smallest dt %.3g), "
-           "%ld Newton iterations (%ld factorisations, and %ld in failed attempts%s), %.1f s "
-           "(assembly %.1f, factorisation %.1f, solves %.1f); output in %s\n",
-           sum.steps, sum.t_final, sum.failed_attempts, sum.dt_smallest, sum.newton_its,
-           sum.factorisations, sum.failed_factorisations, gmres, sum.wall_seconds,
-           sum.t_assembly, sum.t_factor, sum.t_solve, out_dir);
+  /* the summary means something only after a run that succeeded */
+  if (rc == SP_OK && rank == 0) print_summary(&sum, out_dir);
   sp_scene_destroy(&scene);
   free(sets);
   return rc;

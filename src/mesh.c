@@ -18,6 +18,7 @@
  */
 #include "mesh.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -97,6 +98,10 @@ static double lerp_exact_ends(double x0, double x1, int i, int n) {
 /* Rectangle                                                                */
 /* ------------------------------------------------------------------------ */
 
+long long sp_mesh_rectangle_nodes(int nx, int ny) {
+  return ((long long)nx + 1) * ((long long)ny + 1);
+}
+
 int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
                       int ny, sp_mesh **out) {
   SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_rectangle: out is NULL");
@@ -108,11 +113,11 @@ int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
   SP_CHECK(isfinite(y0) && isfinite(y1) && y1 > y0, SP_ERR_INPUT,
            "mesh: need y0 < y1 (finite), got y0 = %g, y1 = %g", y0, y1);
   /* (nx+1)(ny+1) must fit an int, and so must 4 nx ny. */
-  SP_CHECK((double)(nx + 1.0) * (ny + 1.0) < 2.0e9 / 4, SP_ERR_INPUT,
+  SP_CHECK(sp_mesh_rectangle_nodes(nx, ny) < INT_MAX / 4, SP_ERR_INPUT,
            "mesh: nx x ny = %d x %d is too large", nx, ny);
 
   sp_mesh *mesh;
-  SP_CALL(mesh_allocate((nx + 1) * (ny + 1), nx * ny, &mesh));
+  SP_CALL(mesh_allocate((int)sp_mesh_rectangle_nodes(nx, ny), nx * ny, &mesh));
   /* Nodes row by row, i fastest: node (i, j) = j (nx+1) + i. */
   for (int j = 0; j <= ny; ++j)
     for (int i = 0; i <= nx; ++i) {
@@ -353,6 +358,11 @@ static void disk_fill(const disk_grid *g, int buffer_layers,
     }
 }
 
+long long sp_mesh_ellipse_nodes(int refinements, int buffer_layers) {
+  const long long n = 1LL << refinements;
+  return (n + 1) * (n + 1) + 4 * n * (n + buffer_layers);
+}
+
 int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
                     double buffer_width, sp_mesh **out) {
   SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_ellipse: out is NULL");
@@ -373,7 +383,7 @@ int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
 
   disk_grid grid = {1 << refinements, (1 << refinements) + buffer_layers};
   int n = grid.n;
-  int n_nodes = (n + 1) * (n + 1) + 4 * n * grid.n_rings;
+  int n_nodes = (int)sp_mesh_ellipse_nodes(refinements, buffer_layers);
   int n_elems = n * n + 4 * n * grid.n_rings;
 
   sp_mesh *mesh;

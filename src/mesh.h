@@ -43,6 +43,14 @@ int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
 int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
                     double buffer_width, sp_mesh **out);
 
+/** @brief The number of nodes sp_mesh_rectangle makes for @p nx x @p ny
+ *         elements, (nx+1)(ny+1), computed without building the mesh. */
+long long sp_mesh_rectangle_nodes(int nx, int ny);
+
+/** @brief The number of nodes sp_mesh_ellipse makes, (n+1)^2 + 4n(n + L) with
+ *         n = 2^refinements and L = buffer_layers, without building the mesh. */
+long long sp_mesh_ellipse_nodes(int refinements, int buffer_layers);
+
 /** @brief Area of the elements of one region (2x2 Gauss quadrature). */
 double sp_mesh_region_area(const sp_mesh *mesh, int region);
 

@@ -45,6 +45,8 @@
 #include <string.h>
 
 #include "error.h"
+#include "layout.h"
+#include "mesh.h"
 
 /* ------------------------------------------------------------------------ */
 /* The key table                                                            */
@@ -343,10 +345,10 @@ static const sp_key sp_keys[] = {
              "solve (SuperLU_DIST's default; off: solves cost a third, and "
              "the paper's run 5 and the aggregate take the same Newton "
              "iterations to the same energies within 1e-15)"),
-    KEY_INT(SP_SEC_SOLVER, "ilu_fill", solver.ilu_fill, 2, AT_LEAST(1), AT_MOST(20), "-",
+    KEY_INT(SP_SEC_SOLVER, "ilu_fill", solver.ilu_fill, 2, AT_LEAST(0), AT_MOST(20), "-",
             "gmres_ilu: level of fill of the incomplete LU preconditioner "
-            "(ILU(k); 1 stalls on these matrices, 2 is the cheapest that "
-            "converges well)"),
+            "(ILU(k), 0: no fill; 1 stalls on these matrices, 2 is the "
+            "cheapest that converges well)"),
     KEY_FLOAT(SP_SEC_SOLVER, "krylov_tol", solver.krylov_tol, 1e-10, ABOVE(0.0), AT_MOST(1e-3),
               "-",
               "gmres_ilu: a linear solve ends when its residual is below this "
@@ -976,6 +978,20 @@ static int report_cyaml_error(const char *file, cyaml_err_t err,
   if (err == CYAML_ERR_INVALID_ALIAS || err == CYAML_ERR_ALIAS)
     return sp_error_set(SP_ERR_INPUT, "%s: %s: bad YAML alias (libcyaml: %s)",
                         at, path, message);
+  if (err == CYAML_ERR_INTERNAL_ERROR) {
+    /* libcyaml 1.3.1 says "internal error" for an event its state has no
+     * handler for, which input can cause: a key that is itself a mapping
+     * or a sequence, "{x: 1, y}: 2" (tests/scenes/fuzz/). The backtrace's
+     * innermost field is the last one read, not the bad key. */
+    backtrace_where(log, 1, &where);
+    path = where.path[0] ? where.path : "top level";
+    return sp_error_set(SP_ERR_INPUT,
+                        "%s: %s: expected %s; libcyaml cannot read what follows "
+                        "there (a key that is a mapping or a sequence?) (libcyaml: %s)",
+                        file_line(file, where.line, at, sizeof at), path,
+                        path_expectation(where.path, expected, sizeof expected),
+                        cyaml_strerror(err));
+  }
   /* anything else is a schema or library problem, not the user's */
   return sp_error_set(SP_ERR_INTERNAL, "%s: libcyaml failed (%s): %s", file,
                       cyaml_strerror(err), message);
@@ -1051,10 +1067,9 @@ static int apply_raw(sp_scene *scene, const sp_raw_scene *raw,
   return SP_OK;
 }
 
-static int load_file(sp_scene *scene, const char *path) {
-  char *text = NULL;
-  size_t len = 0;
-  SP_CALL(read_file(path, &text, &len));
+/** The values of a scene file's text; @p name is the file in messages. */
+static int load_text(sp_scene *scene, const char *name, const char *text,
+                     size_t len) {
   sp_schema schema;
   build_schema(&schema);
   sp_cyaml_log log = {.n = 0};
@@ -1064,15 +1079,23 @@ static int load_file(sp_scene *scene, const char *path) {
   if (len > 0)
     err = cyaml_load_data((const uint8_t *)text, len, &config, &schema.top,
                           (cyaml_data_t **)&raw, NULL);
-  free(text);
-  if (err != CYAML_OK) return report_cyaml_error(path, err, &log);
+  if (err != CYAML_OK) return report_cyaml_error(name, err, &log);
   /* an empty file, or only comments: libcyaml succeeds with no data */
   SP_CHECK(raw, SP_ERR_INPUT,
            "%s: cells: missing; the file holds no YAML document (empty or "
            "only comments) and a scene needs at least one cell",
-           path);
-  int rc = apply_raw(scene, raw, path);
+           name);
+  int rc = apply_raw(scene, raw, name);
   cyaml_free(&config, &schema.top, raw, 0);
+  return rc;
+}
+
+static int load_file(sp_scene *scene, const char *path) {
+  char *text = NULL;
+  size_t len = 0;
+  SP_CALL(read_file(path, &text, &len));
+  int rc = load_text(scene, path, text, len);
+  free(text);
   return rc;
 }
 
@@ -1214,16 +1237,42 @@ static int check_cells(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
+/** The initial layout (every cell on every node: a run starts with it, also
+ *  before cutting local supports) must be numberable by ints and Epetra's
+ *  32-bit global ids; checked here, before anything that large is allocated. */
+static int check_sizes(const sp_scene *scene, const char *file) {
+  const sp_scene_mesh *m = &scene->mesh;
+  const int rectangle = m->type == SP_MESH_RECTANGLE;
+  const long long nodes = rectangle ? sp_mesh_rectangle_nodes(m->nx, m->ny)
+                                    : sp_mesh_ellipse_nodes(m->refinements, m->buffer_layers);
+  const long long pairs = nodes * scene->n_cells;
+  char mesh_keys[SP_TEXT];
+  if (rectangle)
+    snprintf(mesh_keys, sizeof mesh_keys, "mesh.nx, mesh.ny (%d x %d elements)", m->nx, m->ny);
+  else
+    snprintf(mesh_keys, sizeof mesh_keys,
+             "mesh.refinements, mesh.buffer_layers (%d refinements, %d buffer layers)",
+             m->refinements, m->buffer_layers);
+  SP_CHECK(pairs <= SP_LAYOUT_MAX_PAIRS, SP_ERR_INPUT,
+           "%s: %s and cells (%d cells): too large: %lld nodes x %d cells = %lld (cell, node) "
+           "pairs in the initial layout, 2 x %lld unknowns; at most %d pairs fit the "
+           "solver's 32-bit indices (Epetra's global ids): use fewer elements or cells",
+           file, mesh_keys, scene->n_cells, nodes, scene->n_cells, pairs, pairs,
+           SP_LAYOUT_MAX_PAIRS);
+  return SP_OK;
+}
+
 /* ------------------------------------------------------------------------ */
 /* Public functions                                                         */
 /* ------------------------------------------------------------------------ */
 
-/** Everything sp_scene_load does to a zeroed scene; the caller frees it on
- *  failure, so this may return from anywhere. */
-static int fill_scene(sp_scene *scene, const char *path, int n_set,
-                      const char *const *set) {
+/** Everything sp_scene_load does to a zeroed scene, from the file @p path
+ *  or, when @p text is not NULL, from @p text standing for it; the caller
+ *  frees the scene on failure, so this may return from anywhere. */
+static int fill_scene(sp_scene *scene, const char *path, const char *text,
+                      size_t len, int n_set, const char *const *set) {
   for (int s = 0; s < SP_SEC_CELLS; ++s) store_defaults(scene, (sp_section)s);
-  SP_CALL(load_file(scene, path));
+  SP_CALL(text ? load_text(scene, path, text, len) : load_file(scene, path));
   for (int i = 0; i < n_set; ++i) SP_CALL(apply_override(scene, set[i]));
   /* a clash may come from an override: say so in the prefix */
   char where[SP_TEXT + SP_TEXT];
@@ -1231,23 +1280,35 @@ static int fill_scene(sp_scene *scene, const char *path, int n_set,
            n_set ? " (with its --set overrides)" : "");
   SP_CALL(check_time_and_mesh(scene, where));
   SP_CALL(check_cells(scene, where));
+  SP_CALL(check_sizes(scene, where));
   return SP_OK;
 }
 
-int sp_scene_load(const char *path, int n_set, const char *const *set,
-                  sp_scene **out) {
+static int load_scene(const char *path, const char *text, size_t len,
+                      int n_set, const char *const *set, sp_scene **out) {
   SP_CHECK(path && out && n_set >= 0 && (n_set == 0 || set), SP_ERR_INTERNAL,
            "sp_scene_load: bad arguments");
   *out = NULL;
   sp_scene *scene;
   SP_ALLOC(scene, 1);
-  int rc = fill_scene(scene, path, n_set, set);
+  int rc = fill_scene(scene, path, text, len, n_set, set);
   if (rc != SP_OK) {
     sp_scene_destroy(&scene);
     return rc;
   }
   *out = scene;
   return SP_OK;
+}
+
+int sp_scene_load(const char *path, int n_set, const char *const *set,
+                  sp_scene **out) {
+  return load_scene(path, NULL, 0, n_set, set, out);
+}
+
+int sp_scene_load_text(const char *name, const char *text, size_t len,
+                       int n_set, const char *const *set, sp_scene **out) {
+  SP_CHECK(text || len == 0, SP_ERR_INTERNAL, "sp_scene_load_text: no text");
+  return load_scene(name, text ? text : "", len, n_set, set, out);
 }
 
 double sp_scene_interface_width(const sp_scene *scene) {

@@ -9,6 +9,7 @@
 #ifndef SP_SCENE_H
 #define SP_SCENE_H
 
+#include <stddef.h>
 #include <stdio.h>
 
 #ifdef __cplusplus
@@ -199,6 +200,14 @@ typedef struct sp_scene {
  */
 int sp_scene_load(const char *path, int n_set, const char *const *set,
                   sp_scene **out);
+
+/**
+ * @brief sp_scene_load from a scene file's text held in memory (@p len
+ *        bytes, no terminating NUL needed); @p name stands for the file in
+ *        messages. The same checks and results as sp_scene_load.
+ */
+int sp_scene_load_text(const char *name, const char *text, size_t len,
+                       int n_set, const char *const *set, sp_scene **out);
 
 /** @brief Interface width d = sqrt(kappa / (2 alpha)) of the scene's model. */
 double sp_scene_interface_width(const sp_scene *scene);

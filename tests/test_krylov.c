@@ -7,8 +7,9 @@
  * GMRES iterations (at least one per Newton iteration; none for SuperLU).
  * A tolerance GMRES cannot reach in its 500 iterations makes the step fail
  * with a reason naming GMRES and leaves the state untouched (the stepper
- * retries with a smaller dt), instead of ending the run. Bad fill or
- * tolerance is refused. */
+ * retries with a smaller dt), instead of ending the run. ILU(0) can be
+ * asked for (0 is no default): its first step differs from ILU(2)'s. Bad
+ * fill or tolerance, 0 included, is refused. */
 #include <string.h>
 
 #include "fixtures.h"
@@ -22,6 +23,7 @@ int main(int argc, char **argv) {
   three_cell_problem(&mesh, &layout);
   sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_GMRES_ILU);
   opt.ilu_fill = 2;
+  opt.krylov_tol = 1e-10; /* the scene's default */
   sp_solver ilu2 = make_solver_opts(mesh, layout, &opt);
   opt.ilu_fill = 4;
   sp_solver ilu4 = make_solver_opts(mesh, layout, &opt);
@@ -35,6 +37,7 @@ int main(int argc, char **argv) {
     set_three_touching_disks(mesh, layout, x[s]);
   }
   sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
+  long ilu2_first_gmres = -1;
   for (int step = 0; step < N_STEPS; ++step) {
     int its[3];
     long gmres[3];
@@ -46,6 +49,7 @@ int main(int argc, char **argv) {
       its[s] = rep.newton_its;
       gmres[s] = rep.linear_its;
     }
+    if (step == 0) ilu2_first_gmres = gmres[0];
     CHECK(gmres[0] >= its[0] && gmres[1] >= its[1] && gmres[2] == 0,
           "step %d: GMRES iterations %ld / %ld / %ld", step, gmres[0], gmres[1], gmres[2]);
     double scale = 0, d2 = 0, d4 = 0;
@@ -62,6 +66,24 @@ int main(int argc, char **argv) {
     CHECK(d2 <= 1e-9 * scale && d4 <= 1e-9 * scale, "step %d: states differ by %.3e and %.3e",
           step, d2, d4);
   }
+
+  /* ILU(0), the first step from the same state: if 0 meant "the default"
+   * it would repeat ILU(2)'s GMRES iterations exactly */
+  opt.ilu_fill = 0;
+  sp_solver ilu0 = make_solver_opts(mesh, layout, &opt);
+  double *z = malloc(sizeof(double) * n);
+  set_three_touching_disks(mesh, layout, z);
+  for (int i = 0; i < n; ++i) old[i] = z[i];
+  sp_step_report rep0;
+  const int failed0 = sp_solver_step(ilu0, &data, z, &rep0);
+  printf("ILU(0), first step: %s, %d Newton and %ld GMRES iterations (ILU(2): %ld) %s\n",
+         failed0 ? "failed" : "converged", rep0.newton_its, rep0.linear_its, ilu2_first_gmres,
+         failed0 ? rep0.reason : "");
+  CHECK(failed0 ? strstr(rep0.reason, "GMRES") != NULL : rep0.linear_its != ilu2_first_gmres,
+        "ILU(0): %s with %ld GMRES iterations, as ILU(2)", failed0 ? rep0.reason : "converged",
+        rep0.linear_its);
+  sp_solver_destroy(&ilu0);
+  free(z);
 
   /* an unreachable tolerance: the step fails, the state stays */
   opt.ilu_fill = 2;
@@ -80,7 +102,7 @@ int main(int argc, char **argv) {
   const struct {
     int fill;
     double tol;
-  } bad[] = {{-1, 1e-10}, {2, 1.5}, {2, -1e-8}};
+  } bad[] = {{-1, 1e-10}, {2, 1.5}, {2, -1e-8}, {2, 0}};
   for (size_t b = 0; b < sizeof bad / sizeof bad[0]; ++b) {
     opt.ilu_fill = bad[b].fill;
     opt.krylov_tol = bad[b].tol;
