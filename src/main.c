@@ -2,7 +2,7 @@
  * softpack: the phase-field model of multi-cell aggregates that grow, divide
  * and pack softly (Jiang, Garikipati, Rudraraju; see docs/model.md).
  *
- *   softpack run SCENE.yaml [--out DIR] [--set section.key=value]...
+ *   softpack run SCENE.yaml [--out DIR] [--set section.key=value]... [--quiet]
  *   softpack keys        print every scene key (the table of docs/scene.md)
  *   softpack check-jacobian SCENE.yaml [--steps K] [--set section.key=value]...
  *   softpack info        the build: type, Trilinos, linear solvers, BLAS, MPI
@@ -12,21 +12,24 @@
  * Exit status: 0 success, 2 bad input (nothing written), 1 any other failure.
  */
 #include <dlfcn.h>
+#include <math.h>
 #include <mpi.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "build_info.h"
 #include "checkjac.h"
 #include "error.h"
 #include "scene.h"
 #include "sp_revision.h" /* SP_GIT_REVISION, generated at build time */
+#include "run.h"
 #include "stepper.h"
 
 static void usage(FILE *to) {
   fprintf(to,
-          "usage: softpack run SCENE.yaml [--out DIR] [--set section.key=value]...\n"
+          "usage: softpack run SCENE.yaml [--out DIR] [--set section.key=value]... [--quiet]\n"
           "       softpack keys      print every scene key with unit, default and range\n"
           "       softpack check-jacobian SCENE.yaml [--steps K] [--set section.key=value]...\n"
           "                          compare the ad, hand and fd element Jacobians\n"
@@ -74,14 +77,46 @@ static void print_summary(const sp_run_summary *sum, const char *out_dir) {
          sum->t_assembly, sum->t_factor, sum->t_solve, out_dir);
 }
 
+/** The progress line on a terminal: redrawn in place at most
+ *  SP_PROGRESS_HZ times a second (failure lines go above it, stepper.c). */
+#define SP_PROGRESS_HZ 4
+typedef struct {
+  int rank, drawn;
+  double last_draw;
+} progress;
+
+static int draw_progress(const sp_step_info *s, void *user) {
+  progress *p = user;
+  const int last = s->t >= s->t_end * (1 - 1e-12);
+  if (p->rank != 0 || (!last && s->wall_seconds - p->last_draw < 1.0 / SP_PROGRESS_HZ))
+    return 0;
+  p->last_draw = s->wall_seconds;
+  const double done = s->t / s->t_end;
+  char eta[32] = "-";
+  if (done > 0 && done < 1) {
+    const double left = s->wall_seconds * (1 - done) / done;
+    if (left < 3600) snprintf(eta, sizeof eta, "%d:%02d", (int)(left / 60), (int)left % 60);
+    else if (left < 1e7) snprintf(eta, sizeof eta, "%dh%02d", (int)(left / 3600),
+                                  (int)(left / 60) % 60);
+  }
+  fprintf(stderr, "\r\033[Kstep %d  t %.4g / %.4g (%.0f%%)  dt %.2e  cells %d  Newton %d  "
+                  "%.2f steps/s  ETA %s",
+          s->step, s->t, s->t_end, 100 * done, s->dt, s->n_cells, s->newton_its,
+          s->step / fmax(s->wall_seconds, 1e-9), eta);
+  fflush(stderr);
+  p->drawn = 1;
+  return 0;
+}
+
 static int cmd_run(int argc, char **argv, int rank) {
   const char *scene_path = NULL, *out_dir = NULL;
   const char **sets = calloc(argc > 0 ? argc : 1, sizeof(char *));
-  int n_set = 0;
+  int n_set = 0, quiet = 0;
   SP_CHECK(sets, SP_ERR_MEMORY, "out of memory");
   int rc = SP_OK;
   for (int i = 0; i < argc && rc == SP_OK; ++i) {
     if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) out_dir = argv[++i];
+    else if (strcmp(argv[i], "--quiet") == 0) quiet = 1;
     else if (strcmp(argv[i], "--set") == 0 && i + 1 < argc) sets[n_set++] = argv[++i];
     else if (argv[i][0] == '-')
       rc = sp_error_set(SP_ERR_INPUT, "unknown option or missing value: %s", argv[i]);
@@ -94,13 +129,16 @@ static int cmd_run(int argc, char **argv, int rank) {
     default_out_dir(scene_path, out_default, sizeof out_default);
     out_dir = out_default;
   }
-  sp_scene *scene = NULL;
-  if (rc == SP_OK) rc = sp_scene_load(scene_path, n_set, sets, &scene);
   sp_run_summary sum = {0};
-  if (rc == SP_OK) rc = sp_stepper_run(scene, out_dir, MPI_COMM_WORLD, &sum);
+  /* a progress line only where someone watches: on a terminal, not --quiet */
+  progress prog = {.rank = rank};
+  const int show = !quiet && isatty(fileno(stderr));
+  if (rc == SP_OK)
+    rc = sp_run_file(scene_path, n_set, sets, out_dir, MPI_COMM_WORLD,
+                     show ? draw_progress : NULL, &prog, &sum);
+  if (prog.drawn) fputc('\n', stderr);
   /* the summary means something only after a run that succeeded */
   if (rc == SP_OK && rank == 0) print_summary(&sum, out_dir);
-  sp_scene_destroy(&scene);
   free(sets);
   return rc;
 }

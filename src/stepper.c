@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "cells.h"
 #include "division.h"
@@ -116,6 +117,10 @@ typedef struct {
   sp_support support;    /* local supports (NULL: full) */
   sp_run_summary *sum;
   sp_division_params division;
+  MPI_Comm comm;
+  sp_step_callback on_step; /* may be NULL */
+  void *on_step_user;
+  double t_start;           /* wall clock at the run's start */
 } sp_run;
 
 /** Observables with the mass replaced by the core mass (c >= threshold):
@@ -434,6 +439,7 @@ static int explicit_terms(sp_run *run, sp_shape_coef **shape_coef) {
 static void report_failure(const sp_run *run, int step, double t, double dt, const char *why,
                            const sp_step_report *report, int give_up) {
   if (run->rank != 0) return;
+  if (isatty(fileno(stderr))) fputs("\r\033[K", stderr); /* above a progress line */
   fprintf(stderr, "softpack: step %d at t = %.6g, dt = %.3g: %s", step + 1, t, dt, why);
   if (report) {
     fprintf(stderr, "; |F|:");
@@ -640,6 +646,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       free(mass);
       if (rc != SP_OK) break;
     }
+    const int failed_before = seconds.failed_attempts;
     seconds.step = wall_clock() - step_start;
     /* the state is the one update_supports left, if it ran */
     rc = record_energy(run, step, t, dt_try, report.newton_its, &seconds,
@@ -647,10 +654,24 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     seconds = (sp_step_costs){0};
     step_start = -1;
     if (rc != SP_OK) break;
-    const int last = !(t < tc->t_end - t_tol && step < tc->max_steps);
+    int stop = 0;
+    if (run->on_step) {
+      const sp_step_info info = {.step = step, .t = t, .dt = dt_try, .t_end = tc->t_end,
+                                 .n_cells = run->layout->n_cells,
+                                 .newton_its = report.newton_its,
+                                 .failed_attempts = failed_before,
+                                 .error_estimate = err, .cells = run->obs,
+                                 .wall_seconds = wall_clock() - run->t_start};
+      stop = run->on_step(&info, run->on_step_user) != 0;
+      if (run->n_ranks > 1) /* any rank's stop stops every rank */
+        MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, run->comm);
+      sum->stopped = stop;
+    }
+    const int last = stop || !(t < tc->t_end - t_tol && step < tc->max_steps);
     if (step % run->scene->output.every == 0 || last || n_divided ||
         (lands && on_output_time(run->scene, t)))
       rc = write_snapshot(run, step, t);
+    if (stop) break;
   }
   sum->n_cells = run->layout->n_cells;
   free(shape_coef);
@@ -792,9 +813,15 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
 
 int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
                    sp_run_summary *summary) {
+  return sp_stepper_run_with(scene, out_dir, comm, NULL, NULL, summary);
+}
+
+int sp_stepper_run_with(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
+                        sp_step_callback on_step, void *user, sp_run_summary *summary) {
   sp_run_summary sum = {0};
-  sp_run run = {.scene = scene, .sum = &sum, .out_dir = out_dir};
   const double t0 = wall_clock();
+  sp_run run = {.scene = scene, .sum = &sum, .out_dir = out_dir, .comm = comm,
+                .on_step = on_step, .on_step_user = user, .t_start = t0};
   int rc = run_setup(&run, comm);
   /* Only now, with the input known good, does anything get written. */
   if (rc == SP_OK && run.rank == 0) rc = sp_output_open(out_dir, &run.output);

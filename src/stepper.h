@@ -10,6 +10,7 @@
 
 #include <mpi.h>
 
+#include "cells.h"
 #include "dt_control.h"
 #include "layout.h"
 #include "mesh.h"
@@ -45,7 +46,26 @@ typedef struct {
                                    energy at a support change (0 if none
                                    rose) */
   long unknowns_max;   /**< largest number of unknowns of a step */
+  int stopped;         /**< 1 if a step callback stopped the run early */
 } sp_run_summary;
+
+/** What a step callback sees after each accepted step (the same on every
+ *  MPI rank). */
+typedef struct {
+  int step;              /**< accepted steps so far */
+  double t, dt, t_end;   /**< time reached, the step's dt, the scene's t_end */
+  int n_cells;
+  int newton_its;        /**< of the accepted attempt */
+  int failed_attempts;   /**< retried before it was accepted */
+  double error_estimate; /**< over its tolerance (adaptive); -1: none */
+  const sp_cell_obs *cells; /**< n_cells observables of the new state */
+  double wall_seconds;   /**< since the run began */
+} sp_step_info;
+
+/** Called after every accepted step (and its output) on every rank; a
+ *  non-zero return on any rank stops the run there: the state is written
+ *  as at the end and the run returns SP_OK with summary->stopped = 1. */
+typedef int (*sp_step_callback)(const sp_step_info *info, void *user);
 
 /** @brief The mesh a scene describes. */
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out);
@@ -69,6 +89,11 @@ int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *lay
  */
 int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
                    sp_run_summary *summary);
+
+/** @brief sp_stepper_run with @p on_step (may be NULL) called after every
+ *         accepted step with @p user. */
+int sp_stepper_run_with(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
+                        sp_step_callback on_step, void *user, sp_run_summary *summary);
 
 #ifdef __cplusplus
 }

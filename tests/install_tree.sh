@@ -59,6 +59,14 @@ status=0
 [ "$status" -eq 2 ] && grep -q "time.dt" "$tmp/bad.err" ||
   fail "bad override: status $status, $(cat "$tmp/bad.err")"
 
+# run_scene: a scene run through softpack/run.h with a step callback
+ran=$(cd "$tmp" && "$tmp/examples/run_scene" "$scene" "$tmp/run_scene_out" 0 time.dt=1e-6 \
+  time.t_end=1e-5 time.max_steps=2 output.pictures=false) ||
+  fail "run_scene: $ran"
+echo "$ran"
+grep -q "^step 2 t " <<< "$ran" && grep -q "^2 steps, stopped early: no$" <<< "$ran" ||
+  fail "run_scene printed otherwise"
+
 # pkg-config --cflags --libs softpack
 flags=$(PKG_CONFIG_PATH="$prefix/$lib/pkgconfig" "$pkg_config" --cflags --libs softpack)
 libdir=$(PKG_CONFIG_PATH="$prefix/$lib/pkgconfig" "$pkg_config" --variable=libdir softpack)

@@ -1,0 +1,55 @@
+/**
+ * @file run.h
+ * @brief Running a scene from another program: the entry point the
+ *        `softpack run` command is a client of.
+ *
+ *     #include <softpack/run.h>
+ *     static int watch(const sp_step_info *s, void *user) {
+ *       printf("step %d t = %g, %d cells\n", s->step, s->t, s->n_cells);
+ *       return s->n_cells >= 8;          // non-zero: stop after this step
+ *     }
+ *     ...
+ *     MPI_Init(&argc, &argv);
+ *     const char *set[] = {"time.t_end=0.01"};
+ *     sp_run_summary sum;
+ *     int rc = sp_run_file("scene.yaml", 1, set, "out/mine", MPI_COMM_WORLD,
+ *                          watch, NULL, &sum);
+ *     if (rc != SP_OK) fprintf(stderr, "%s\n", sp_error_message());
+ *
+ * Every rank of @p comm calls it alike. Return codes are sp_error_code
+ * (error.h): SP_ERR_INPUT for a bad scene or override (nothing written),
+ * SP_ERR_SOLVER when a step failed beyond its retries (the last good state
+ * is written), others for I/O, memory and internal errors; the message is
+ * sp_error_message(). The callback (may be NULL) sees every accepted step
+ * (stepper.h: sp_step_info, the cells' observables included) and stops the
+ * run by returning non-zero (summary->stopped = 1, the state written as at
+ * the end).
+ */
+#ifndef SP_RUN_H
+#define SP_RUN_H
+
+#include <mpi.h>
+#include <stddef.h>
+
+#include "error.h"
+#include "stepper.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief Run the scene file @p path with @p n_set "section.key=value"
+ *         overrides into @p out_dir. @p summary may be NULL. */
+int sp_run_file(const char *path, int n_set, const char *const *set, const char *out_dir,
+                MPI_Comm comm, sp_step_callback on_step, void *user, sp_run_summary *summary);
+
+/** @brief The same for a scene given as YAML text (@p len bytes; @p name
+ *         names it in messages). */
+int sp_run_text(const char *name, const char *text, size_t len, int n_set,
+                const char *const *set, const char *out_dir, MPI_Comm comm,
+                sp_step_callback on_step, void *user, sp_run_summary *summary);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
