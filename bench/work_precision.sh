@@ -13,7 +13,8 @@
 # REF_TOL; default 1e-5), TOLS_BE, TOLS_BDF2 (tolerance lists), FIXED
 # (divisors of dt, default "1 2 4 8"), SOLVER (extra --set options of every
 # run but "today"; default: the program's defaults), SKIP_REF=1 (reuse the
-# reference in OUT). Every run logs at multiples of output.interval
+# reference in OUT), KEEP=1 (keep the runs OUT holds from an interrupted
+# report: a run that finished left OUT/NAME.done). Every run logs at multiples of output.interval
 # (INTERVAL, default 0.002), where the energies are compared.
 # Rows: name, steps, factorisations (accepted and failed attempts), failed
 # attempts, wall seconds (sum of the per-step seconds), then the errors
@@ -49,14 +50,18 @@ dt=${dt:-2e-4}
 run() { # NAME SET...
   local name=$1
   shift
+  if [ "${KEEP:-0}" = 1 ] && [ -f "$out/$name.done" ]; then return 0; fi
   echo "softpack run $scene $* (-> $out/$name)" >&2
+  rm -f "$out/$name.done"
   build/softpack run "$scene" --out "$out/$name" "${common[@]}" "$@" > "$out/$name.log" 2>&1 ||
     { echo "run $name failed: see $out/$name.log" >&2; return 1; }
+  touch "$out/$name.done"
 }
 
 echo "# bench/work_precision.sh $which, $(date -u +%Y-%m-%d), $(nproc) cores, scene $scene"
 echo "# reference: adaptive BDF2, rtol = atol = $ref_tol; solver options: ${SOLVER:-defaults}"
 if [ "${SKIP_REF:-0}" != 1 ]; then
+  [ "${KEEP:-0}" = 1 ] || rm -f "$out"/*.done
   run ref --set time.control=adaptive --set time.scheme=bdf2 --set time.rtol="$ref_tol" \
       --set time.atol="$ref_tol" "${solver[@]}"
 fi

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# A pinned scene (the paper's settings: fixed dt, backward Euler, SuperLU,
+# no predictor, no Jacobian reuse) against softpack's defaults (adaptive
+# BDF2, MUMPS, linear predictor, jacobian_reuse 0.1) on the same scene, one
+# after the other in one run (docs/benchmarks.md):
+#
+#   bench/defaults_vs_today.sh [SCENE] [OUT]    (default: the paper's run 1,
+#                                                 inputs/paper/constant_volume_16.yaml)
+#
+# Prints steps, factorisations (accepted and failed attempts), failed
+# attempts and wall seconds of each, their ratio, and how far the default
+# run's end state is from the pinned one's (bench_compare_runs: energy at
+# the common logged times, masses and centres of the cells at t_end, L2 of
+# c at t_end). Pictures off.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scene=${1:-inputs/paper/constant_volume_16.yaml}
+out=${2:-out/defaults_vs_today}
+export OMP_NUM_THREADS=1
+mkdir -p "$out"
+echo "# bench/defaults_vs_today.sh $scene, $(date -u +%Y-%m-%d), $(nproc) cores"
+build/softpack run "$scene" --out "$out/today" --set output.pictures=false \
+  > "$out/today.log" 2>&1
+build/softpack run "$scene" --out "$out/default" --set output.pictures=false \
+  --set time.control=adaptive --set time.scheme=bdf2 --set solver.linear=mumps \
+  --set solver.predictor=linear --set solver.jacobian_reuse=0.1 > "$out/default.log" 2>&1
+read -r s0 f0 x0 w0 _ < <(build/bench/bench_compare_runs "$out/today" "$out/today")
+read -r s1 f1 x1 w1 e m c l2 < <(build/bench/bench_compare_runs "$out/default" "$out/today")
+printf "| run | steps | factorisations | failed | wall s |\n|---|---|---|---|---|\n"
+printf "| pinned (today) | %d | %d | %d | %.1f |\n" "$s0" "$f0" "$x0" "$w0"
+printf "| defaults | %d | %d | %d | %.1f |\n" "$s1" "$f1" "$x1" "$w1"
+awk -v a="$w0" -v b="$w1" -v fa="$f0" -v fb="$f1" \
+  'BEGIN { printf "speed-up %.2fx in wall time, %.2fx fewer factorisations\n", a / b, fa / fb }'
+echo "defaults against pinned: energy $e, masses $m, centres $c, L2 of c at t_end $l2"
