@@ -37,10 +37,17 @@ int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
                         const double *state_to) {
   const size_t n_from = 2 * (size_t)from->n_pairs, n_to = 2 * (size_t)to->n_pairs;
   const int nc = to->n_cells;
-  double *w = malloc(sizeof(double) * ((size_t)to->n_pairs + 2 * (size_t)nc) + 1);
-  SP_CHECK(w, SP_ERR_MEMORY, "out of memory moving the time scheme's history");
-  double *shift = w + to->n_pairs, *weight = shift + nc;
-  int rc = sp_cells_pair_weights(mesh, to, w);
+  if (h->n == 0) {
+    sp_history_free(h);
+    return SP_OK;
+  }
+  double *w_from = malloc(sizeof(double) * ((size_t)from->n_pairs + (size_t)to->n_pairs +
+                                            3 * (size_t)nc) + 1);
+  SP_CHECK(w_from, SP_ERR_MEMORY, "out of memory moving the time scheme's history");
+  double *w_to = w_from + from->n_pairs, *mass_from = w_to + to->n_pairs;
+  double *mass_to = mass_from + nc, *weight = mass_to + nc;
+  int rc = sp_cells_pair_weights(mesh, from, w_from);
+  if (rc == SP_OK) rc = sp_cells_pair_weights(mesh, to, w_to);
   for (int j = 0; j < 2 && rc == SP_OK; ++j) {
     if (j >= h->n) { /* nothing valid to carry: drop the storage */
       free(h->past[j]);
@@ -52,21 +59,26 @@ int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
       rc = sp_error_set(SP_ERR_MEMORY, "out of memory moving the time scheme's history");
       break;
     }
-    for (size_t i = 0; i < n_from; ++i) h->past[j][i] = state_from[i] - h->past[j][i];
-    sp_layout_transfer(from, h->past[j], to, past, 0.0);
-    /* each cell's increment of c to zero mass, spread over its support */
-    for (int k = 0; k < nc; ++k) shift[k] = weight[k] = 0.0;
+    double *inc = h->past[j]; /* the increment state - past, in place */
+    for (size_t i = 0; i < n_from; ++i) inc[i] = state_from[i] - inc[i];
+    sp_layout_transfer(from, inc, to, past, 0.0);
+    /* each cell's increment of c keeps the mass it had (0 when s = 0, so a
+     * BDF2 step after the change still conserves mass): the difference
+     * spread evenly over the cell's new support */
+    for (int k = 0; k < nc; ++k) mass_from[k] = mass_to[k] = weight[k] = 0.0;
+    for (int p = 0; p < from->n_pairs; ++p) mass_from[from->pair_cell[p]] += w_from[p] * inc[2 * p];
     for (int p = 0; p < to->n_pairs; ++p) {
-      shift[to->pair_cell[p]] += w[p] * past[2 * p];
-      weight[to->pair_cell[p]] += w[p];
+      mass_to[to->pair_cell[p]] += w_to[p] * past[2 * p];
+      weight[to->pair_cell[p]] += w_to[p];
     }
-    for (int k = 0; k < nc; ++k) shift[k] = weight[k] > 0 ? shift[k] / weight[k] : 0.0;
-    for (int p = 0; p < to->n_pairs; ++p) past[2 * p] -= shift[to->pair_cell[p]];
+    for (int k = 0; k < nc; ++k)
+      mass_to[k] = weight[k] > 0 ? (mass_to[k] - mass_from[k]) / weight[k] : 0.0;
+    for (int p = 0; p < to->n_pairs; ++p) past[2 * p] -= mass_to[to->pair_cell[p]];
     for (size_t i = 0; i < n_to; ++i) past[i] = state_to[i] - past[i];
     free(h->past[j]);
     h->past[j] = past;
   }
-  free(w);
+  free(w_from);
   return rc;
 }
 

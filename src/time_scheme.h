@@ -71,8 +71,10 @@ void sp_history_free(sp_history *h);
  * @brief Carry the past states to a new layout by their increments against
  *        the state: past_new = state_new - transfer(state_old - past_old),
  *        0 increments on new pairs, then each cell's increment shifted to
- *        zero mass (weights: sp_cells_pair_weights on the new layout), so a
- *        BDF2 step after a support change still conserves each cell's mass.
+ *        the mass it had on the old layout (0 with s = 0; weights:
+ *        sp_cells_pair_weights), so a BDF2 step after a support change
+ *        still conserves each cell's mass, and a growing cell's history
+ *        keeps its growth.
  */
 int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
                         const double *state_from, const sp_layout *to,

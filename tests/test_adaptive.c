@@ -3,7 +3,8 @@
  * - every accepted step's error estimate is <= 1 (rejected steps are never
  *   accepted) and the runs did estimate;
  * - the cells' total mass changes by at most 1e-12 relative per step,
- *   through both divisions and every step sequence;
+ *   through both divisions and every step sequence, with full supports and
+ *   with local ones (BDF2's history carried across support changes);
  * - the age divisions land on their times (t_div and 2 t_div) to 1e-12;
  * - output.interval writes fields at its multiples (to 1e-12), the last
  *   step lands on t_end. */
@@ -19,20 +20,24 @@
 #define T_END 0.0045
 #define INTERVAL 0.001
 
-static void check_run(const char *scheme) {
-  char out[64], set_scheme[64];
-  snprintf(out, sizeof out, "adaptive_%s", scheme);
+static void check_run(const char *scheme, const char *support) {
+  char out[64], set_scheme[64], set_support[64];
+  snprintf(out, sizeof out, "adaptive_%s_%s", scheme, support);
   snprintf(set_scheme, sizeof set_scheme, "time.scheme=%s", scheme);
+  snprintf(set_support, sizeof set_support, "layout.support=%s", support);
   const char *set[] = {"mesh.refinements=3", "division.t_div=0.002", "time.t_end=0.0045",
                        "time.control=adaptive", set_scheme, "time.rtol=1e-2",
                        "time.atol=1e-2", "output.interval=0.001", "output.every=100000",
-                       "output.pictures=false"};
+                       "output.pictures=false", set_support};
   sp_scene *scene;
-  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 10, set, &scene));
+  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 11, set, &scene));
   sp_run_summary sum;
   CHECK_OK(sp_stepper_run(scene, out, MPI_COMM_WORLD, &sum));
-  printf("%s: %d steps, %d failed attempts, %d divisions, t = %.17g\n", scheme, sum.steps,
-         sum.failed_attempts, sum.divisions, sum.t_final);
+  printf("%s, %s supports: %d steps, %d failed attempts, %d divisions, %d support changes, "
+         "t = %.17g\n", scheme, support, sum.steps, sum.failed_attempts, sum.divisions,
+         sum.layout_changes, sum.t_final);
+  if (strcmp(support, "local") == 0)
+    CHECK(sum.layout_changes >= 3, "only %d support changes", sum.layout_changes);
   CHECK(sum.divisions == 3 && sum.n_cells == 4, "%d divisions, %d cells", sum.divisions,
         sum.n_cells);
   CHECK(sum.t_final == T_END, "ended at t = %.17g", sum.t_final);
@@ -99,8 +104,9 @@ static void check_run(const char *scheme) {
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
-  check_run("be");
-  check_run("bdf2");
+  check_run("be", "full");
+  check_run("bdf2", "full");
+  check_run("bdf2", "local");
   MPI_Finalize();
   TEST_DONE();
 }
