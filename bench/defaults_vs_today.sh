@@ -14,18 +14,19 @@
 # c at t_end). Pictures off.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+build=${BUILD:-build} # the build directory whose programs run
 scene=${1:-inputs/paper/constant_volume_16.yaml}
 out=${2:-out/defaults_vs_today}
 export OMP_NUM_THREADS=1
 mkdir -p "$out"
-echo "# bench/defaults_vs_today.sh $scene, $(date -u +%Y-%m-%d), $(nproc) cores"
-build/softpack run "$scene" --out "$out/today" --set output.pictures=false \
+echo "# bench/defaults_vs_today.sh $scene, $(date -u +%Y-%m-%d), $(nproc --all) cores"
+"$build/softpack" run "$scene" --out "$out/today" --set output.pictures=false \
   > "$out/today.log" 2>&1
-build/softpack run "$scene" --out "$out/default" --set output.pictures=false \
+"$build/softpack" run "$scene" --out "$out/default" --set output.pictures=false \
   --set time.control=adaptive --set time.scheme=bdf2 --set solver.linear=mumps \
   --set solver.predictor=linear --set solver.jacobian_reuse=0.1 > "$out/default.log" 2>&1
-read -r s0 f0 x0 w0 _ < <(build/bench/bench_compare_runs "$out/today" "$out/today")
-read -r s1 f1 x1 w1 e m c l2 < <(build/bench/bench_compare_runs "$out/default" "$out/today")
+read -r s0 f0 x0 w0 _ < <("$build"/bench/bench_compare_runs "$out/today" "$out/today")
+read -r s1 f1 x1 w1 e m c l2 < <("$build"/bench/bench_compare_runs "$out/default" "$out/today")
 printf "| run | steps | factorisations | failed | wall s |\n|---|---|---|---|---|\n"
 printf "| pinned (today) | %d | %d | %d | %.1f |\n" "$s0" "$f0" "$x0" "$w0"
 printf "| defaults | %d | %d | %d | %.1f |\n" "$s1" "$f1" "$x1" "$w1"

@@ -26,6 +26,7 @@
 # Jacobian reuse. Plots: OUT/wp_<scene>_{factorisations,wall}.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+build=${BUILD:-build} # the build directory whose programs run
 which=${1:-a}
 case "$which" in
   a) scene=inputs/bench/relax_3.yaml ;;
@@ -53,12 +54,12 @@ run() { # NAME SET...
   if [ "${KEEP:-0}" = 1 ] && [ -f "$out/$name.done" ]; then return 0; fi
   echo "softpack run $scene $* (-> $out/$name)" >&2
   rm -f "$out/$name.done"
-  build/softpack run "$scene" --out "$out/$name" "${common[@]}" "$@" > "$out/$name.log" 2>&1 ||
+  "$build/softpack" run "$scene" --out "$out/$name" "${common[@]}" "$@" > "$out/$name.log" 2>&1 ||
     { echo "run $name failed: see $out/$name.log" >&2; return 1; }
   touch "$out/$name.done"
 }
 
-echo "# bench/work_precision.sh $which, $(date -u +%Y-%m-%d), $(nproc) cores, scene $scene"
+echo "# bench/work_precision.sh $which, $(date -u +%Y-%m-%d), $(nproc --all) cores, scene $scene"
 echo "# reference: adaptive BDF2, rtol = atol = $ref_tol; solver options: ${SOLVER:-defaults}"
 if [ "${SKIP_REF:-0}" != 1 ]; then
   [ "${KEEP:-0}" = 1 ] || rm -f "$out"/*.done
@@ -90,7 +91,7 @@ printf "| %-20s | %5s | %6s | %6s | %8s | %9s | %9s | %9s | %9s |\n" run steps f
 echo "|---|---|---|---|---|---|---|---|---|"
 points=()
 for n in "${names[@]}"; do
-  read -r steps facts failed wall e m c l2 < <(build/bench/bench_compare_runs "$out/$n" "$out/ref")
+  read -r steps facts failed wall e m c l2 < <("$build"/bench/bench_compare_runs "$out/$n" "$out/ref")
   printf "| %-20s | %5d | %6d | %6d | %8.1f | %9.2e | %9.2e | %9.2e | %9.2e |\n" "$n" "$steps" \
     "$facts" "$failed" "$wall" "$e" "$m" "$c" "$l2"
   series=${n%_*}
@@ -101,7 +102,7 @@ for axis in factorisations wall; do
   for p in "${points[@]}"; do
     read -r s f l2 w <<< "$p"
     if [ "$axis" = factorisations ]; then echo "$s $f $l2"; else echo "$s $w $l2"; fi
-  done | build/bench/bench_wp_plot "$out/wp_${which}_$axis.png" \
+  done | "$build"/bench/bench_wp_plot "$out/wp_${which}_$axis.png" \
     "$( [ "$axis" = wall ] && echo "wall seconds" || echo "factorisations")" \
     "relative L2 error of c at T" "work-precision, scene $which ($(date -u +%Y-%m-%d))"
 done

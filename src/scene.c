@@ -258,9 +258,9 @@ static const sp_key sp_keys[] = {
              "time scheme: backward Euler (be, the paper's) or variable-step "
              "BDF2 (bdf2, second order; BE after the start and each "
              "division)"),
-    KEY_FLOAT(SP_SEC_TIME, "rtol", time.rtol, 1e-2, ABOVE(0.0), UNBOUNDED, "-",
+    KEY_FLOAT(SP_SEC_TIME, "rtol", time.rtol, 1e-1, ABOVE(0.0), UNBOUNDED, "-",
               "adaptive: relative tolerance of a step's local error in c"),
-    KEY_FLOAT(SP_SEC_TIME, "atol", time.atol, 1e-2, ABOVE(0.0), UNBOUNDED, "-",
+    KEY_FLOAT(SP_SEC_TIME, "atol", time.atol, 1e-1, ABOVE(0.0), UNBOUNDED, "-",
               "adaptive: absolute tolerance of a step's local error in c"),
     KEY_FLOAT(SP_SEC_TIME, "dt_max", time.dt_max, 1.0, ABOVE(0.0), UNBOUNDED,
               "T", "adaptive: the largest step (must be >= dt_min)"),

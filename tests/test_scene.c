@@ -87,8 +87,8 @@ static void test_defaults(void) {
   /* the fast path by default (docs/time-stepping.md) */
   CHECK(s->time.control == SP_CONTROL_ADAPTIVE && s->time.scheme == SP_TIME_BDF2,
         "control %d scheme %d", s->time.control, s->time.scheme);
-  CHECK_NEAR(s->time.rtol, 1e-2, 0.0);
-  CHECK_NEAR(s->time.atol, 1e-2, 0.0);
+  CHECK_NEAR(s->time.rtol, 1e-1, 0.0);
+  CHECK_NEAR(s->time.atol, 1e-1, 0.0);
   CHECK_NEAR(s->time.dt_max, 1.0, 0.0);
   CHECK_NEAR(s->output.interval, 0.0, 0.0);
   CHECK_NEAR(s->noise.background, 0.0, 0.0);
