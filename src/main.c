@@ -87,9 +87,9 @@ typedef struct {
 
 static int draw_progress(const sp_step_info *s, void *user) {
   progress *p = user;
-  const int last = s->t >= s->t_end * (1 - 1e-12);
-  if (p->rank != 0 || (!last && s->wall_seconds - p->last_draw < 1.0 / SP_PROGRESS_HZ))
-    return 0;
+  if (p->rank != 0 || (p->drawn && !s->last &&
+                       s->wall_seconds - p->last_draw < 1.0 / SP_PROGRESS_HZ))
+    return 0; /* the first and the last step always, between at most 4 a second */
   p->last_draw = s->wall_seconds;
   const double done = s->t / s->t_end;
   char eta[32] = "-";

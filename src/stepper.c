@@ -661,7 +661,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                                  .newton_its = report.newton_its,
                                  .failed_attempts = failed_before,
                                  .error_estimate = err, .cells = run->obs,
-                                 .wall_seconds = wall_clock() - run->t_start};
+                                 .wall_seconds = wall_clock() - run->t_start,
+                                 .last = !(t < tc->t_end - t_tol && step < tc->max_steps)};
       stop = run->on_step(&info, run->on_step_user) != 0;
       if (run->n_ranks > 1) /* any rank's stop stops every rank */
         MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, run->comm);

@@ -60,6 +60,7 @@ typedef struct {
   double error_estimate; /**< over its tolerance (adaptive); -1: none */
   const sp_cell_obs *cells; /**< n_cells observables of the new state */
   double wall_seconds;   /**< since the run began */
+  int last;              /**< 1 on the run's last step (t_end or max_steps) */
 } sp_step_info;
 
 /** Called after every accepted step (and its output) on every rank; a

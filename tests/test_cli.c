@@ -22,6 +22,28 @@ static void expect_input_error(const char *args, const char *key) {
   CHECK(!exists("cli_out"), "'%s': the output directory was created", args);
 }
 
+/* The progress line: drawn in place (ESC[K) on a terminal (a pty from
+ * util-linux's script), absent with --quiet and when stderr is a pipe. */
+static void check_progress_line(void) {
+  const char *scene = SP_SOURCE_DIR "/tests/scenes/local_short.yaml";
+  const char *sets = "--set time.max_steps=2 --set mesh.nx=20 --set mesh.ny=12 "
+                     "--set layout.support=full";
+  char cmd[4096], out[16384];
+  snprintf(cmd, sizeof cmd, "OMP_NUM_THREADS=1 %s run %s --out cli_progress %s 2>&1",
+           SP_BINARY, scene, sets);
+  CHECK(run_command(cmd, out, sizeof out) == 0 && !strchr(out, '\033'),
+        "progress drawn into a pipe: %s", out);
+  for (int quiet = 0; quiet < 2; ++quiet) {
+    snprintf(cmd, sizeof cmd,
+             "script -qec 'OMP_NUM_THREADS=1 %s run %s --out cli_progress %s%s' /dev/null",
+             SP_BINARY, scene, sets, quiet ? " --quiet" : "");
+    const int status = run_command(cmd, out, sizeof out);
+    const int drawn = strstr(out, "\033[Kstep 2  t ") != NULL;
+    CHECK(status == 0 && drawn == !quiet, "%s: status %d, progress line %s: %s",
+          quiet ? "--quiet" : "a terminal", status, drawn ? "drawn" : "absent", out);
+  }
+}
+
 int main(void) {
   const char *bad_dir = SP_SOURCE_DIR "/tests/scenes/bad";
   DIR *dir = opendir(bad_dir);
@@ -60,5 +82,6 @@ int main(void) {
   expect_input_error("explode", "explode");
   char out[8192];
   CHECK(run_softpack("--help", out, sizeof out) == 0 && strstr(out, "usage"), "--help: %s", out);
+  check_progress_line();
   TEST_DONE();
 }
