@@ -210,21 +210,31 @@ static int grow_array(void **ptr, size_t elem, int n_old, int n) {
   return SP_OK;
 }
 
+/** The per-pair buffers of a step on the run's layout: c^n and the source,
+ *  and only what the scheme uses: c_hat (BDF2) and the error estimate's
+ *  extrapolation (adaptive control). */
+static int alloc_step_buffers(sp_run *run) {
+  const size_t n_pairs = (size_t)run->layout->n_pairs;
+  free(run->state_old);
+  free(run->state_eff);
+  free(run->scratch);
+  free(run->source);
+  run->state_old = run->state_eff = run->scratch = run->source = NULL;
+  SP_ALLOC(run->state_old, 2 * n_pairs);
+  SP_ALLOC(run->source, n_pairs);
+  if (run->scene->time.scheme == SP_TIME_BDF2) SP_ALLOC(run->state_eff, 2 * n_pairs);
+  if (run->scene->time.control == SP_CONTROL_ADAPTIVE) SP_ALLOC(run->scratch, 2 * n_pairs);
+  return SP_OK;
+}
+
 /** Make (layout, state) the run's own, resize the per-pair buffers and
  *  hand the layout to the solver (the history is the caller's to move). */
 static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
   sp_layout_destroy(&run->layout);
   free(run->state);
-  free(run->state_old);
-  free(run->state_eff);
-  free(run->scratch);
-  free(run->source);
   run->layout = layout;
   run->state = state;
-  SP_ALLOC(run->state_old, 2 * (size_t)layout->n_pairs);
-  SP_ALLOC(run->state_eff, 2 * (size_t)layout->n_pairs);
-  SP_ALLOC(run->scratch, 2 * (size_t)layout->n_pairs);
-  SP_ALLOC(run->source, layout->n_pairs);
+  SP_CALL(alloc_step_buffers(run));
   return sp_solver_attach(run->solver, run->mesh, run->layout);
 }
 
@@ -419,8 +429,7 @@ static int explicit_terms(sp_run *run, sp_shape_coef **shape_coef) {
   if (run->scene->source.rate > 0)
     SP_CALL(sp_source_fill(run->layout, run->state_old, n_cells, run->source_on,
                            run->scene->source.rate, run->source));
-  if (!*shape_coef && !(run->scene->shape.delta1 > 0 || run->scene->shape.delta2 > 0))
-    return SP_OK;
+  if (!(run->scene->shape.delta1 > 0 || run->scene->shape.delta2 > 0)) return SP_OK;
   /* from the observables of c^n; implicit steps follow the new moments
    * through the gains */
   sp_shape_coef *grown = realloc(*shape_coef, sizeof *grown * (size_t)n_cells);
@@ -456,30 +465,24 @@ static void report_failure(const sp_run *run, int step, double t, double dt, con
  *  it counts as the crossing (sp_division_params.tolerance). */
 #define SP_MASS_LANDING_TOLERANCE 1e-3
 
-/** The fraction of the step just solved (run->state_old -> run->state,
- *  observables of c^n in run->obs) at which the first mass division due
- *  in it was reached, when the step overshot it by more than
+/** The fraction of the step just solved (observables of c^n in run->obs,
+ *  of its end in @p obs_new) at which the first mass division due in it was
+ *  reached, when the step overshot it by more than
  *  SP_MASS_LANDING_TOLERANCE; 1 otherwise. */
-static int mass_crossing(sp_run *run, double t_old, double t_new, double *theta) {
-  *theta = 1.0;
-  const int n = run->layout->n_cells;
-  if (n >= run->n_max) return SP_OK;
-  sp_cell_obs *obs;
-  SP_ALLOC(obs, n);
-  int rc = sp_cells_observe(run->mesh, run->layout, run->state,
-                            run->scene->division.observe_threshold, obs);
-  for (int k = 0; k < n && rc == SP_OK; ++k) {
-    const double m_old = run->obs[k].mass_core, m_new = obs[k].mass_core;
+static double mass_crossing(const sp_run *run, double t_old, double t_new,
+                            const sp_cell_obs *obs_new) {
+  double theta = 1.0;
+  for (int k = 0; k < run->layout->n_cells; ++k) {
+    const double m_old = run->obs[k].mass_core, m_new = obs_new[k].mass_core;
     if (!sp_division_due(&run->division, &run->birth[k], t_old, t_new, m_old, m_new)) continue;
     const double f = sp_division_crossing_fraction(&run->division, &run->birth[k], t_old, t_new,
                                                    m_old, m_new);
     /* overshot: past the threshold by more than the tolerance */
     const double over = m_new - sp_division_threshold(&run->division, &run->birth[k]) *
                                     (1 + SP_MASS_LANDING_TOLERANCE);
-    if (f > 0 && f < 1 && over > 0) *theta = fmin(*theta, f);
+    if (f > 0 && f < 1 && over > 0) theta = fmin(theta, f);
   }
-  free(obs);
-  return rc;
+  return theta;
 }
 
 /** The time loop proper. */
@@ -500,6 +503,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   SP_CALL(write_snapshot(run, 0, t));
   const double t_tol = 1e-12 * tc->t_end;
   sp_shape_coef *shape_coef = NULL; /* per cell, refreshed before each step */
+  sp_cell_obs *obs_new = NULL;      /* adaptive, mass criterion: see mass_crossing */
   sp_step_costs seconds = {0}; /* of the step being attempted */
   double step_start = -1;
   int rc = SP_OK;
@@ -548,6 +552,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       break;
     }
     double err = -1.0;
+    int observed = 0; /* obs_new holds the observables of the step's end */
     const char *why = report.reason;
     char why_error[160];
     if (solved == 0 && adaptive) {
@@ -562,10 +567,16 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     else if (sp_dt_judge(&run->dtc, dt_try, err) == SP_DT_REJECT) {
       solved = 1; /* never accepted: retried with a smaller step */
       give_up = sp_dt_give_up(&run->dtc);
-    } else if (adaptive && run->scene->division.criterion == SP_DIVIDE_BY_MASS) {
-      double theta;
-      rc = mass_crossing(run, t, t + dt_try, &theta);
+    } else if (adaptive && run->scene->division.criterion == SP_DIVIDE_BY_MASS &&
+               n_cells < run->n_max) { /* observed here, kept if the step stands */
+      sp_cell_obs *grown_obs = realloc(obs_new, sizeof *obs_new * (size_t)n_cells);
+      if (!grown_obs) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
+      obs_new = grown_obs;
+      rc = sp_cells_observe(run->mesh, run->layout, run->state,
+                            run->scene->division.observe_threshold, obs_new);
       if (rc != SP_OK) break;
+      observed = 1;
+      const double theta = mass_crossing(run, t, t + dt_try, obs_new);
       if (theta < 1) { /* land on the crossing: redo the step shorter */
         run->dtc.dt_next = fmax(theta * dt_try, tc->dt_min);
         why = "a cell's mass passed its division mass inside the step (landing on it)";
@@ -618,8 +629,9 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     if (!grown) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
     core_mass_old = grown;
     for (int k = 0; k < n_cells; ++k) core_mass_old[k] = run->obs[k].mass_core;
-    rc = sp_cells_observe(run->mesh, run->layout, run->state,
-                          run->scene->division.observe_threshold, run->obs);
+    if (observed) memcpy(run->obs, obs_new, sizeof *obs_new * (size_t)n_cells);
+    else rc = sp_cells_observe(run->mesh, run->layout, run->state,
+                               run->scene->division.observe_threshold, run->obs);
     int n_divided = 0, have_energy = 0;
     sp_energy_parts energy_after_supports;
     if (rc == SP_OK) rc = divide_due_cells(run, t_old, t, step, core_mass_old, &n_divided);
@@ -654,6 +666,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     seconds = (sp_step_costs){0};
     step_start = -1;
     if (rc != SP_OK) break;
+    const int ends = !(t < tc->t_end - t_tol && step < tc->max_steps);
     int stop = 0;
     if (run->on_step) {
       const sp_step_info info = {.step = step, .t = t, .dt = dt_try, .t_end = tc->t_end,
@@ -662,20 +675,20 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                                  .failed_attempts = failed_before,
                                  .error_estimate = err, .cells = run->obs,
                                  .wall_seconds = wall_clock() - run->t_start,
-                                 .last = !(t < tc->t_end - t_tol && step < tc->max_steps)};
+                                 .last = ends};
       stop = run->on_step(&info, run->on_step_user) != 0;
       if (run->n_ranks > 1) /* any rank's stop stops every rank */
         MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, run->comm);
       sum->stopped = stop;
     }
-    const int last = stop || !(t < tc->t_end - t_tol && step < tc->max_steps);
-    if (step % run->scene->output.every == 0 || last || n_divided ||
+    if (step % run->scene->output.every == 0 || ends || stop || n_divided ||
         (lands && on_output_time(run->scene, t)))
       rc = write_snapshot(run, step, t);
     if (stop) break;
   }
   sum->n_cells = run->layout->n_cells;
   free(shape_coef);
+  free(obs_new);
   free(core_mass_old);
   return rc;
 }
@@ -743,10 +756,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
   const int n = scene->n_cells;
   SP_ALLOC(run->state, n_values);
-  SP_ALLOC(run->state_old, n_values);
-  SP_ALLOC(run->state_eff, n_values);
-  SP_ALLOC(run->scratch, n_values);
-  SP_ALLOC(run->source, run->layout->n_pairs);
+  SP_CALL(alloc_step_buffers(run));
   SP_ALLOC(run->obs, n);
   SP_ALLOC(run->birth, n);
   SP_ALLOC(run->source_on, n);
