@@ -10,7 +10,8 @@
 #                                     (1 -> 8 cells, divisions; T = 0.016)
 #
 # Environment: REF_TOL (the reference: adaptive BDF2 at rtol = atol =
-# REF_TOL; default 1e-5), TOLS_BE, TOLS_BDF2 (tolerance lists), FIXED
+# REF_TOL; default 1e-5 on a), REF_DT (instead: fixed-dt BDF2 at REF_DT;
+# default on b: dt / 128, 16x below the finest fixed step), TOLS_BE, TOLS_BDF2 (tolerance lists), FIXED
 # (divisors of dt, default "1 2 4 8"), SOLVER (extra --set options of every
 # run but "today"; default: the program's defaults), SKIP_REF=1 (reuse the
 # reference in OUT), KEEP=1 (keep the runs OUT holds from an interrupted
@@ -23,7 +24,9 @@
 # centre distance of the cells at T, and the relative L2 norm of the
 # fields' difference at T. "today" is the configuration before
 # time.control existed: fixed BE at dt with SuperLU, no predictor, no
-# Jacobian reuse. Plots: OUT/wp_<scene>_{factorisations,wall}.png.
+# Jacobian reuse. Every other run takes the program's default solver
+# settings (`softpack keys`) over what the scene pins, and "default" the
+# program's defaults of time.* too: the paper's scenes pin the paper's. Plots: OUT/wp_<scene>_{factorisations,wall}.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${BUILD:-build} # the build directory whose programs run
@@ -35,6 +38,7 @@ case "$which" in
 esac
 out=${2:-out/work_precision_$which}
 ref_tol=${REF_TOL:-1e-5}
+ref_dt=${REF_DT:-}
 tols_be=${TOLS_BE:-"1e-1 3e-2 1e-2"}
 tols_bdf2=${TOLS_BDF2:-"3e-1 1e-1 3e-2 1e-2"}
 fixed=${FIXED:-"1 2 4 8"}
@@ -47,6 +51,21 @@ common=(--set output.interval="$interval" --set output.every=100000000
 dt=$(awk '/^time:/ { if (match($0, /dt: *[0-9.eE+-]+/)) { s = substr($0, RSTART, RLENGTH);
        sub(/dt: */, "", s); print s } }' "$scene")
 dt=${dt:-2e-4}
+[ "$which" = b ] && [ -z "${REF_TOL:-}" ] && [ -z "$ref_dt" ] &&
+  ref_dt=$(awk -v dt="$dt" 'BEGIN { printf "%.10g", dt / 128 }')
+# The program's defaults of KEY...: "--set KEY=VALUE" pairs from `softpack keys`.
+defaults_of() {
+  local k
+  for k in "$@"; do
+    "$build/softpack" keys | awk -F'|' -v k="\`$k\`" '{ gsub(/ /, "", $2); gsub(/ /, "", $5) }
+      $2 == k { gsub(/`/, "", $2); print "--set"; print $2 "=" $5 }'
+  done
+}
+mapfile -t fast < <(defaults_of solver.linear solver.predictor solver.jacobian_reuse)
+mapfile -t defaults < <(defaults_of time.control time.scheme time.rtol time.atol)
+[ ${#fast[@]} = 6 ] && [ ${#defaults[@]} = 8 ] ||
+  { echo "bench/work_precision.sh: cannot read the defaults from softpack keys" >&2; exit 2; }
+solver=("${fast[@]}" "${solver[@]}")
 
 run() { # NAME SET...
   local name=$1
@@ -60,11 +79,17 @@ run() { # NAME SET...
 }
 
 echo "# bench/work_precision.sh $which, $(date -u +%Y-%m-%d), $(nproc --all) cores, scene $scene"
-echo "# reference: adaptive BDF2, rtol = atol = $ref_tol; solver options: ${SOLVER:-defaults}"
+if [ -n "$ref_dt" ]; then
+  echo "# reference: fixed-dt BDF2, dt = $ref_dt; solver options: ${solver[*]}"
+  ref=(--set time.control=fixed --set time.scheme=bdf2 --set time.dt="$ref_dt")
+else
+  echo "# reference: adaptive BDF2, rtol = atol = $ref_tol; solver options: ${solver[*]}"
+  ref=(--set time.control=adaptive --set time.scheme=bdf2 --set time.rtol="$ref_tol"
+       --set time.atol="$ref_tol")
+fi
 if [ "${SKIP_REF:-0}" != 1 ]; then
   [ "${KEEP:-0}" = 1 ] || rm -f "$out"/*.done
-  run ref --set time.control=adaptive --set time.scheme=bdf2 --set time.rtol="$ref_tol" \
-      --set time.atol="$ref_tol" "${solver[@]}"
+  run ref "${ref[@]}" "${solver[@]}"
 fi
 names=()
 run today --set time.control=fixed --set time.scheme=be --set time.dt="$dt" \
@@ -84,7 +109,7 @@ for tol in $tols_bdf2; do
       --set time.rtol="$tol" --set time.atol="$tol" "${solver[@]}" &&
     names+=("adaptive_bdf2_$tol")
 done
-run default "${solver[@]}" && names+=(default)
+run default "${defaults[@]}" "${solver[@]}" && names+=(default)
 
 printf "| %-20s | %5s | %6s | %6s | %8s | %9s | %9s | %9s | %9s |\n" run steps facts failed \
   wall_s energy mass centre L2
