@@ -34,9 +34,7 @@ struct sp_output_s {
   char *energy_path, *cells_path, *divisions_path;
   FILE *energy, *cells, *divisions;
   int n_fields, cap_fields;
-  int *field_step;      /**< step of each .vtu written, in write order */
-  double *field_t;      /**< its time */
-  int parallel;         /**< 1: the fields are .pvtu files of pieces */
+  sp_output_field *fields; /**< each fields file written, in write order */
 };
 
 /* ------------------------------------------------------------------------ */
@@ -195,40 +193,102 @@ static int sp_log_done(FILE *f, const char *path, int printed) {
   return SP_OK;
 }
 
+/** A log's buffer: a step's rows (cells.csv: one per cell) go to the file
+ *  in one write at the flush, so a killed run leaves whole lines. */
+#define SP_LOG_BUFFER (1 << 20)
+
+/** Open a log: a new one with its header (@p header), or an existing one
+ *  to append to (@p header NULL). */
 static int sp_log_open(const char *path, const char *header, FILE **f) {
-  *f = fopen(path, "w");
+  *f = fopen(path, header ? "w" : "a");
   SP_CHECK(*f, SP_ERR_IO, "cannot open '%s' for writing: %s", path,
            strerror(errno));
-  return sp_log_done(*f, path, fprintf(*f, "%s\n", header));
+  setvbuf(*f, NULL, _IOFBF, SP_LOG_BUFFER);
+  return header ? sp_log_done(*f, path, fprintf(*f, "%s\n", header)) : SP_OK;
 }
 
-int sp_output_open(const char *dir, sp_output *out) {
+/**
+ * Cut the log @p path back to its header and the rows whose column
+ * @p column (0-based) is a step <= @p step; a last line without its newline
+ * (a killed run's) goes too. Rewritten atomically; a missing log is fine
+ * (it is started anew). Sets *@p exists.
+ */
+static int sp_log_cut(const char *path, int column, int step, int *exists) {
+  size_t len;
+  FILE *f = fopen(path, "rb");
+  *exists = f != NULL;
+  if (!f) return SP_OK;
+  fseek(f, 0, SEEK_END);
+  len = (size_t)ftell(f);
+  rewind(f);
+  char *text = malloc(len + 1);
+  if (!text) {
+    fclose(f);
+    return sp_error_set(SP_ERR_MEMORY, "out of memory reading '%s'", path);
+  }
+  const size_t got = fread(text, 1, len, f);
+  fclose(f);
+  SP_CHECK(got == len, SP_ERR_IO, "cannot read '%s'", path);
+  text[len] = '\0';
+  size_t keep = 0;
+  for (size_t at = 0; at < len;) {
+    const char *nl = memchr(text + at, '\n', len - at);
+    if (!nl) break; /* a torn last line */
+    const size_t end = (size_t)(nl - text) + 1;
+    if (at > 0) { /* a row: its step column */
+      const char *p = text + at;
+      for (int c = 0; c < column && p < nl; ++c) {
+        p = memchr(p, ',', (size_t)(nl - p));
+        p = p ? p + 1 : nl;
+      }
+      char *num_end;
+      const long row_step = strtol(p, &num_end, 10);
+      if (num_end == p || row_step > step) break; /* rows are in step order */
+    }
+    keep = end;
+    at = end;
+  }
+  const int rc = sp_write_file_atomic(path, text, keep);
+  free(text);
+  return rc;
+}
+
+/** The logs: file name, header, the 0-based column holding the step. */
+static const struct {
+  const char *name, *header;
+  int step_column;
+} sp_logs[3] = {
+    {"energy.csv",
+     "step,t,dt,newton_its,n_cells,energy,bulk,gradient,repulsion,buffer,shape,seconds,"
+     "assembly_s,factorisation_s,solves_s,supports_s,support_changed,unknowns,factorisations,"
+     "failed_attempts,failed_factorisations,residual_rise,linear_its,error_estimate",
+     0},
+    {"cells.csv", "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass,area", 0},
+    {"divisions.csv",
+     "t,step,parent,child,axis_angle,parent_mass_before,parent_mass_after,child_mass_after", 1}};
+
+/** Open @p dir's logs: new ones (@p resume_step < 0), or the existing ones
+ *  cut back to the rows of steps <= @p resume_step and appended to. */
+static int output_open(const char *dir, int resume_step, sp_output *out) {
   *out = NULL;
   SP_CALL(sp_mkdir_p(dir));
   struct sp_output_s *o;
   SP_ALLOC(o, 1);
   o->dir = sp_strfmt("%s", dir);
-  o->energy_path = sp_strfmt("%s/energy.csv", dir);
-  o->cells_path = sp_strfmt("%s/cells.csv", dir);
-  o->divisions_path = sp_strfmt("%s/divisions.csv", dir);
+  o->energy_path = sp_strfmt("%s/%s", dir, sp_logs[0].name);
+  o->cells_path = sp_strfmt("%s/%s", dir, sp_logs[1].name);
+  o->divisions_path = sp_strfmt("%s/%s", dir, sp_logs[2].name);
+  char *paths[3] = {o->energy_path, o->cells_path, o->divisions_path};
+  FILE **files[3] = {&o->energy, &o->cells, &o->divisions};
   int rc = SP_OK;
   if (!o->dir || !o->energy_path || !o->cells_path || !o->divisions_path)
     rc = sp_error_set(SP_ERR_MEMORY, "out of memory naming files in '%s'",
                       dir);
-  if (rc == SP_OK)
-    rc = sp_log_open(o->energy_path,
-                     "step,t,dt,newton_its,n_cells,energy,bulk,gradient,"
-                     "repulsion,buffer,shape,seconds,assembly_s,factorisation_s,solves_s,"
-                     "supports_s,support_changed,unknowns,factorisations,failed_attempts,"
-                     "failed_factorisations,residual_rise,linear_its,error_estimate",
-                     &o->energy);
-  if (rc == SP_OK)
-    rc = sp_log_open(o->cells_path, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass,area",
-                     &o->cells);
-  if (rc == SP_OK)
-    rc = sp_log_open(o->divisions_path,
-                     "t,step,parent,child,axis_angle,parent_mass_before,"
-                     "parent_mass_after,child_mass_after", &o->divisions);
+  for (int i = 0; i < 3 && rc == SP_OK; ++i) {
+    int exists = 0;
+    if (resume_step >= 0) rc = sp_log_cut(paths[i], sp_logs[i].step_column, resume_step, &exists);
+    if (rc == SP_OK) rc = sp_log_open(paths[i], exists ? NULL : sp_logs[i].header, files[i]);
+  }
   if (rc != SP_OK) {
     sp_output_close(&o); /* keeps the first error's message */
     return rc;
@@ -236,6 +296,8 @@ int sp_output_open(const char *dir, sp_output *out) {
   *out = o;
   return SP_OK;
 }
+
+int sp_output_open(const char *dir, sp_output *out) { return output_open(dir, -1, out); }
 
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,
@@ -278,6 +340,11 @@ int sp_output_division(sp_output out, double t, int step, int parent,
 
 const char *sp_output_dir(sp_output out) { return out ? out->dir : NULL; }
 
+int sp_output_fields_list(sp_output out, const sp_output_field **fields) {
+  *fields = out->fields;
+  return out->n_fields;
+}
+
 int sp_output_close(sp_output *out) {
   if (!out || !*out) return SP_OK;
   struct sp_output_s *o = *out;
@@ -296,8 +363,7 @@ int sp_output_close(sp_output *out) {
   free(o->energy_path);
   free(o->cells_path);
   free(o->divisions_path);
-  free(o->field_step);
-  free(o->field_t);
+  free(o->fields);
   free(o);
   *out = NULL;
   return rc;
@@ -531,7 +597,7 @@ static int sp_pvd_write(const struct sp_output_s *o) {
   for (int i = 0; i < o->n_fields; ++i)
     sp_strbuf_add(&b, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" "
                       "file=\"fields_%06d.%s\"/>\n",
-                  o->field_t[i], o->field_step[i], o->parallel ? "pvtu" : "vtu");
+                  o->fields[i].t, o->fields[i].step, o->fields[i].pvtu ? "pvtu" : "vtu");
   sp_strbuf_add(&b, "  </Collection>\n</VTKFile>\n");
   int rc;
   char *path = sp_strfmt("%s/fields.pvd", o->dir);
@@ -545,26 +611,23 @@ static int sp_pvd_write(const struct sp_output_s *o) {
   return rc;
 }
 
-/** Record (step, t); writing the same step again replaces its time (a step
- *  redone after a failure must not be listed twice). */
-static int sp_fields_record(struct sp_output_s *o, int step, double t) {
+/** Record (step, t) and its kind; writing the same step again replaces it
+ *  (a step redone after a failure must not be listed twice). */
+static int sp_fields_record(struct sp_output_s *o, int step, double t, int pvtu) {
+  const sp_output_field entry = {step, t, pvtu};
   for (int i = 0; i < o->n_fields; ++i)
-    if (o->field_step[i] == step) {
-      o->field_t[i] = t;
+    if (o->fields[i].step == step) {
+      o->fields[i] = entry;
       return SP_OK;
     }
   if (o->n_fields == o->cap_fields) {
     int cap = o->cap_fields ? 2 * o->cap_fields : 16;
-    int *s = realloc(o->field_step, (size_t)cap * sizeof *s);
-    if (s) o->field_step = s;
-    double *tt = realloc(o->field_t, (size_t)cap * sizeof *tt);
-    if (tt) o->field_t = tt;
-    SP_CHECK(s && tt, SP_ERR_MEMORY, "out of memory listing output files");
+    sp_output_field *f = realloc(o->fields, (size_t)cap * sizeof *f);
+    SP_CHECK(f, SP_ERR_MEMORY, "out of memory listing output files");
+    o->fields = f;
     o->cap_fields = cap;
   }
-  o->field_step[o->n_fields] = step;
-  o->field_t[o->n_fields] = t;
-  ++o->n_fields;
+  o->fields[o->n_fields++] = entry;
   return SP_OK;
 }
 
@@ -588,7 +651,7 @@ int sp_output_fields(sp_output out, const sp_mesh *mesh,
   }
   free(path);
   SP_CALL(rc);
-  SP_CALL(sp_fields_record(out, step, t));
+  SP_CALL(sp_fields_record(out, step, t, 0));
   return sp_pvd_write(out);
 }
 
@@ -663,8 +726,137 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
   free(path);
   free(b.s);
   SP_CALL(rc);
-  out->parallel = 1;
-  SP_CALL(sp_fields_record(out, step, t));
+  SP_CALL(sp_fields_record(out, step, t, 1));
   return sp_pvd_write(out);
 }
 
+int sp_output_resume(const char *dir, int step, int n_fields, const sp_output_field *fields,
+                     sp_output *out) {
+  SP_CALL(output_open(dir, step, out));
+  for (int i = 0; i < n_fields; ++i)
+    if (fields[i].step <= step) {
+      int rc = sp_fields_record(*out, fields[i].step, fields[i].t, fields[i].pvtu);
+      if (rc != SP_OK) {
+        sp_output_close(out);
+        return rc;
+      }
+    }
+  return (*out)->n_fields ? sp_pvd_write(*out) : SP_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Reading a .vtu back (initial.from)                                       */
+/* ------------------------------------------------------------------------ */
+
+/** Decode base64 @p in (up to '<' or the end) into @p out; its length. */
+static size_t sp_b64_decode(const char *in, unsigned char *out) {
+  size_t n = 0;
+  unsigned acc = 0;
+  int bits = 0;
+  for (; *in && *in != '<'; ++in) {
+    const char c = *in;
+    int v;
+    if (c >= 'A' && c <= 'Z') v = c - 'A';
+    else if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
+    else if (c >= '0' && c <= '9') v = c - '0' + 52;
+    else if (c == '+') v = 62;
+    else if (c == '/') v = 63;
+    else continue; /* whitespace, padding */
+    acc = (acc << 6) | (unsigned)v;
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out[n++] = (unsigned char)(acc >> bits);
+    }
+  }
+  return n;
+}
+
+/** The values of the DataArray @p name of a .vtu's text (malloc'd; its
+ *  byte count in *bytes), or NULL if it is missing or malformed. */
+static void *sp_vtu_array(const char *xml, const char *name, size_t *bytes) {
+  char key[64];
+  snprintf(key, sizeof key, "Name=\"%s\"", name);
+  const char *p = strstr(xml, key);
+  if (!p || !(p = strchr(p, '>'))) return NULL;
+  const char *end = strchr(p, '<');
+  if (!end) return NULL;
+  unsigned char *raw = malloc((size_t)(end - p) + 8);
+  if (!raw) return NULL;
+  const size_t n = sp_b64_decode(p + 1, raw);
+  uint64_t header = 0;
+  if (n >= 8) memcpy(&header, raw, 8);
+  if (n < 8 || n != 8 + header) {
+    free(raw);
+    return NULL;
+  }
+  memmove(raw, raw + 8, header);
+  *bytes = header;
+  return raw;
+}
+
+void sp_vtu_fields_free(sp_vtu_fields *v) {
+  free(v->xy);
+  free(v->c);
+  free(v->mu);
+  *v = (sp_vtu_fields){0};
+}
+
+int sp_vtu_read(const char *path, sp_vtu_fields *out) {
+  *out = (sp_vtu_fields){0};
+  FILE *f = fopen(path, "rb");
+  SP_CHECK(f, SP_ERR_INPUT, "%s: cannot open it: %s", path, strerror(errno));
+  fseek(f, 0, SEEK_END);
+  const long len = ftell(f);
+  rewind(f);
+  char *xml = len >= 0 ? malloc((size_t)len + 1) : NULL;
+  const size_t got = xml ? fread(xml, 1, (size_t)len, f) : 0;
+  fclose(f);
+  if (!xml) return sp_error_set(SP_ERR_MEMORY, "%s: out of memory reading it", path);
+  xml[got] = '\0';
+  int rc = SP_OK;
+  if (!strstr(xml, "<VTKFile type=\"UnstructuredGrid\""))
+    rc = sp_error_set(SP_ERR_INPUT, "%s: not a .vtu of one process's fields (a .pvtu's "
+                                    "pieces are not read)", path);
+  size_t bytes = 0;
+  double *pts = rc == SP_OK ? sp_vtu_array(xml, "Points", &bytes) : NULL;
+  if (rc == SP_OK && (!pts || bytes % (3 * sizeof(double))))
+    rc = sp_error_set(SP_ERR_INPUT, "%s: no readable Points array (not softpack's .vtu?)", path);
+  const int n = (int)(bytes / (3 * sizeof(double)));
+  int n_cells = 0;
+  while (rc == SP_OK) { /* c_1, c_2, ... as long as they exist */
+    char name[32];
+    snprintf(name, sizeof name, "Name=\"c_%d\"", n_cells + 1);
+    if (!strstr(xml, name)) break;
+    ++n_cells;
+  }
+  if (rc == SP_OK && n_cells == 0)
+    rc = sp_error_set(SP_ERR_INPUT, "%s: no cell fields (c_1, ...) in it", path);
+  if (rc == SP_OK) {
+    out->n_points = n;
+    out->n_cells = n_cells;
+    out->xy = malloc(sizeof(double) * 2 * (size_t)n + 1);
+    out->c = malloc(sizeof(double) * (size_t)n * n_cells + 1);
+    out->mu = malloc(sizeof(double) * (size_t)n * n_cells + 1);
+    if (!out->xy || !out->c || !out->mu) rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
+  }
+  for (int i = 0; rc == SP_OK && i < n; ++i) {
+    out->xy[2 * i] = pts[3 * i];
+    out->xy[2 * i + 1] = pts[3 * i + 1];
+  }
+  for (int k = 0; rc == SP_OK && k < n_cells; ++k)
+    for (int which = 0; rc == SP_OK && which < 2; ++which) {
+      char name[32];
+      snprintf(name, sizeof name, "%s_%d", which ? "mu" : "c", k + 1);
+      size_t b = 0;
+      double *v = sp_vtu_array(xml, name, &b);
+      if (!v || b != sizeof(double) * (size_t)n)
+        rc = sp_error_set(SP_ERR_INPUT, "%s: array %s missing or of the wrong size", path, name);
+      else memcpy((which ? out->mu : out->c) + (size_t)k * n, v, b);
+      free(v);
+    }
+  free(pts);
+  free(xml);
+  if (rc != SP_OK) sp_vtu_fields_free(out);
+  return rc;
+}

@@ -21,6 +21,38 @@ typedef struct sp_output_s *sp_output;
 /** @brief Create @p dir (and parents) and start the CSV logs with headers. */
 int sp_output_open(const char *dir, sp_output *out);
 
+/** One fields file of fields.pvd: fields_<step>.vtu, or .pvtu of pieces. */
+typedef struct {
+  int step;
+  double t;
+  int pvtu;
+} sp_output_field;
+
+/**
+ * @brief Continue a run in @p dir from its step @p step (a restart): the
+ *        CSV logs are cut back to the rows of steps <= @p step (and a torn
+ *        last line) and appended to; fields.pvd lists @p fields up to
+ *        @p step. Logs that do not exist are started with their headers.
+ */
+int sp_output_resume(const char *dir, int step, int n_fields, const sp_output_field *fields,
+                     sp_output *out);
+
+/** What sp_vtu_read finds in a softpack .vtu: the points (x, y) and every
+ *  cell's c and mu at them (cell-major: c[k n_points + i]). */
+typedef struct {
+  int n_points, n_cells;
+  double *xy, *c, *mu;
+} sp_vtu_fields;
+
+/** @brief Read a .vtu softpack wrote on one process (fields_<step>.vtu).
+ *         SP_ERR_INPUT if it is not one. */
+int sp_vtu_read(const char *path, sp_vtu_fields *out);
+void sp_vtu_fields_free(sp_vtu_fields *v);
+
+/** @brief The fields files written so far, in order (a checkpoint saves
+ *         them): their number, and *fields. */
+int sp_output_fields_list(sp_output out, const sp_output_field **fields);
+
 /** What one accepted step cost, in wall-clock seconds of rank 0: the whole
  *  step (every attempt, divisions, support changes), the solver's phases
  *  and the support change (local supports), whether one happened, and the
