@@ -172,6 +172,12 @@ int sp_solver_ranks(sp_solver s);
 int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh,
                           const sp_layout_view *layout);
 
+/** @brief The next factorisation starts from scratch (ordering, symbolic
+ *         analysis, a direct solver's row permutation), as after a new
+ *         layout: after a checkpoint, so that a run continued from it
+ *         factorises exactly as the run that wrote it goes on to. */
+int sp_solver_refactor_next(sp_solver s);
+
 /**
  * @brief One backward-Euler step by Newton. On entry @p state is the initial
  *        guess; on success it holds the new state. On failure it is restored

@@ -94,6 +94,14 @@ int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh, const sp_layout
   });
 }
 
+int sp_solver_refactor_next(sp_solver s) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl != nullptr, "the solver was not created");
+    s->impl->refactor_next();
+  });
+}
+
 int sp_solver_step(sp_solver s, const sp_step_data *data, double *state, sp_step_report *report) {
   if (!s) return SP_API_ERR + 1;
   int newton = 0;

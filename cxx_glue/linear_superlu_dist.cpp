@@ -7,10 +7,14 @@
 // So every factorisation starts from fresh copies of the caller's arrays,
 // and after a refactorisation the refinement's communication pattern is
 // rebuilt on the next solve. With an unchanged pattern the factorisation
-// reuses the orderings, scalings and the symbolic factorisation
-// (Fact = SamePattern_SameRowPerm, the row permutation of the first matrix
-// of this pattern). Factorisation (nrhs = 0) and solves (Fact = FACTORED) are
-// separate calls, so they are timed separately.
+// reuses the column ordering (Fact = SamePattern) and computes the row
+// permutation and scalings (MC64) of each matrix anew, so a factorisation
+// depends on its matrix alone, not on the matrices before it: a run
+// continued from a checkpoint factorises exactly as the run that wrote it.
+// SamePattern_SameRowPerm (the first matrix's row permutation kept) was
+// faster by 5-30% of the factorisation time: the price of bit-identical
+// continuation, measured in docs/restart.md. Factorisation (nrhs = 0) and
+// solves (Fact = FACTORED) are separate calls, so they are timed separately.
 //
 // superlu_ddefs.h clashes with SuperLU's slu_ddefs.h: keep it alone in this TU.
 #include <superlu_ddefs.h>
@@ -73,7 +77,7 @@ class SuperLUDist final : public DirectSolver {
       options_.Fact = DOFACT;
       ++symbolic_;
     } else {
-      options_.Fact = SamePattern_SameRowPerm;
+      options_.Fact = SamePattern;
       // The solve set-up is for solve_nrhs_ columns: for another count,
       // drop it (with the refinement's), the next solve rebuilds it on the
       // fresh matrix below.

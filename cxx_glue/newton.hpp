@@ -23,6 +23,8 @@ class Solver {
   Solver(MPI_Comm comm, const sp_solver_options &options);
 
   void set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout);
+  /// The next factorisation from scratch, as after a new layout.
+  void refactor_next() { pattern_changed_ = true; }
   int ranks() const { return comm_.NumProc(); }
   // Returns 0 when converged, 1 when Newton failed (state restored).
   int step(const sp_step_data &data, double *state, sp_step_report &report);
