@@ -147,25 +147,38 @@ double sp_random_symmetric(unsigned long long *rng) {
   return 2.0 * (double)(z >> 11) / 9007199254740992.0 - 1.0;
 }
 
-int sp_cells_initial_state(const sp_scene *scene, const sp_mesh *mesh,
-                           const sp_layout *layout, double *state) {
-  const double d = sp_scene_interface_width(scene);
+int sp_cells_fill(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *layout,
+                  sp_profile_fn profile_of, void *ctx, double *state) {
   const sp_scene_noise *noise = &scene->noise;
   for (int k = 0; k < layout->n_cells; ++k) {
-    const sp_scene_cell *cell = &scene->cells[k];
     /* One stream per cell, so adding a cell does not change the others. */
     unsigned long long rng = (unsigned long long)noise->seed * 1000003ULL + (unsigned long long)k;
     for (int i = 0; i < mesh->n_nodes; ++i) {
       const double xi = noise->amplitude > 0 ? sp_random_symmetric(&rng) : 0.0;
       const int p = sp_layout_pair(layout, k, i);
       if (p < 0) continue;
-      const double r = hypot(mesh->xy[2 * i] - cell->x, mesh->xy[2 * i + 1] - cell->y);
-      const double profile = cell->profile == SP_PROFILE_SHARP
-                                 ? (r <= cell->radius ? 1.0 : 0.0)
-                                 : 1.0 / (1.0 + exp((r - cell->radius) / d));
+      const double profile = profile_of(k, mesh->xy[2 * i], mesh->xy[2 * i + 1], ctx);
       state[2 * p] = profile + (1.0 - profile) * (noise->background + noise->amplitude * xi);
       state[2 * p + 1] = 0.0;
     }
   }
   return SP_OK;
+}
+
+/** The scene's cell k: a disk with the tanh profile of width d, or sharp. */
+static double disk_profile(int k, double x, double y, void *ctx) {
+  const sp_scene *scene = ctx;
+  const sp_scene_cell *cell = &scene->cells[k];
+  const double r = hypot(x - cell->x, y - cell->y);
+  if (cell->profile == SP_PROFILE_SHARP) return r <= cell->radius ? 1.0 : 0.0;
+  return sp_cells_profile(r - cell->radius, sp_scene_interface_width(scene));
+}
+
+double sp_cells_profile(double signed_distance, double d) {
+  return 1.0 / (1.0 + exp(signed_distance / d));
+}
+
+int sp_cells_initial_state(const sp_scene *scene, const sp_mesh *mesh,
+                           const sp_layout *layout, double *state) {
+  return sp_cells_fill(scene, mesh, layout, disk_profile, (void *)scene, state);
 }

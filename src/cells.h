@@ -77,6 +77,18 @@ int sp_cells_initial_state(const sp_scene *scene, const sp_mesh *mesh,
  *         the same sequence on every machine for a given seed. */
 double sp_random_symmetric(unsigned long long *rng);
 
+/** The equilibrium profile across an interface of width @p d at signed
+ *  distance @p signed_distance from it (> 0 outside): 1 / (1 + e^(s/d)). */
+double sp_cells_profile(double signed_distance, double d);
+
+/** Cell k's profile (c without noise, in [0, 1]) at (x, y). */
+typedef double (*sp_profile_fn)(int k, double x, double y, void *ctx);
+
+/** @brief The initial state of every cell of @p layout from @p profile_of,
+ *         with the scene's noise outside the cells (mu = 0). */
+int sp_cells_fill(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *layout,
+                  sp_profile_fn profile_of, void *ctx, double *state);
+
 #ifdef __cplusplus
 }
 #endif

@@ -9,6 +9,7 @@
 #include "cells.h"
 #include "dt_control.h"
 #include "error.h"
+#include "initial.h"
 #include "layout.h"
 #include "mesh.h"
 #include "scene.h"
@@ -40,7 +41,9 @@ static int checkjac_setup(checkjac *c) {
   const sp_scene *scene = c->scene;
   MPI_Comm_rank(MPI_COMM_WORLD, &c->rank);
   SP_CALL(sp_mesh_from_scene(scene, &c->mesh));
-  SP_CALL(sp_layout_create_full(c->mesh->n_nodes, scene->n_cells, &c->layout));
+  int n_cells;
+  SP_CALL(sp_initial_cell_count(scene, &n_cells));
+  SP_CALL(sp_layout_create_full(c->mesh->n_nodes, n_cells, &c->layout));
   sp_solver_options opt;
   sp_solver_options_from_scene(scene, &opt);
   sp_model_from_scene(scene, &c->model);
@@ -50,7 +53,7 @@ static int checkjac_setup(checkjac *c) {
   const size_t n_values = 2 * (size_t)c->layout->n_pairs;
   SP_ALLOC(c->state, n_values);
   SP_ALLOC(c->state_old, n_values);
-  return sp_cells_initial_state(scene, c->mesh, c->layout, c->state);
+  return sp_initial_state(scene, c->mesh, c->layout, c->state);
 }
 
 static int compare(checkjac *c, const sp_step_data *data, int a, int b, double *out) {

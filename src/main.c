@@ -3,17 +3,21 @@
  * and pack softly (Jiang, Garikipati, Rudraraju; see docs/model.md).
  *
  *   softpack run SCENE.yaml [--out DIR] [--set section.key=value]... [--quiet]
+ *                [--restart CHECKPOINT | --resume DIR] [--restart-as-initial]
  *   softpack keys        print every scene key (the table of docs/scene.md)
  *   softpack check-jacobian SCENE.yaml [--steps K] [--set section.key=value]...
  *   softpack info        the build: type, Trilinos, linear solvers, BLAS, MPI
  *   softpack --version   the version and the git revision it was built from
  *   softpack --help
  *
- * Exit status: 0 success, 2 bad input (nothing written), 1 any other failure.
+ * Exit status: 0 success, 2 bad input (nothing written), 1 any other failure,
+ * 75 stopped by SIGTERM, SIGINT or SIGUSR1 after writing a checkpoint (resume
+ * with --resume DIR; docs/restart.md).
  */
 #include <dlfcn.h>
 #include <math.h>
 #include <mpi.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,6 +34,8 @@
 static void usage(FILE *to) {
   fprintf(to,
           "usage: softpack run SCENE.yaml [--out DIR] [--set section.key=value]... [--quiet]\n"
+          "                    [--restart CHECKPOINT | --resume DIR] [--restart-as-initial]\n"
+          "                          continue from a checkpoint, or DIR's newest (docs/restart.md)\n"
           "       softpack keys      print every scene key with unit, default and range\n"
           "       softpack check-jacobian SCENE.yaml [--steps K] [--set section.key=value]...\n"
           "                          compare the ad, hand and fd element Jacobians\n"
@@ -38,7 +44,8 @@ static void usage(FILE *to) {
           "       softpack --help\n"
           "Outputs go to DIR (default out/<scene name>): energy.csv, cells.csv,\n"
           "fields.pvd + fields_*.vtu (ParaView), cells_*.png, energy.png.\n"
-          "Exit status: 0 ok, 2 bad input (nothing written), 1 failure.\n");
+          "Exit status: 0 ok, 2 bad input (nothing written), 1 failure, 75 stopped by\n"
+          "SIGTERM/SIGINT/SIGUSR1 after writing a checkpoint (resume with --resume DIR).\n");
 }
 
 /** "softpack 0.1 (git 0123456789ab)": --version, and the first line of info. */
@@ -66,6 +73,8 @@ static void print_summary(const sp_run_summary *sum, const char *out_dir) {
            sum->support_mass_dropped, sum->support_energy_rise, sum->unknowns_max);
   else
     printf("softpack: at most %ld unknowns per step\n", sum->unknowns_max);
+  if (sum->checkpoints)
+    printf("softpack: %d checkpoints written (%.2f s)\n", sum->checkpoints, sum->t_checkpoints);
   char gmres[64] = "";
   if (sum->linear_its > 0)
     snprintf(gmres, sizeof gmres, "; %ld GMRES iterations", sum->linear_its);
@@ -108,8 +117,40 @@ static int draw_progress(const sp_step_info *s, void *user) {
   return 0;
 }
 
-static int cmd_run(int argc, char **argv, int rank) {
+/** Exit status of a run stopped by a signal after writing its checkpoint
+ *  (EX_TEMPFAIL: "try again", here with --resume). */
+#define SP_EXIT_STOPPED 75
+
+/** The first signal asks for a checkpoint at the end of the step; a
+ *  second one (^C again) ends the process at once, as without a handler. */
+static void on_stop_signal(int sig) {
+  static volatile sig_atomic_t seen;
+  if (seen) {
+    signal(sig, SIG_DFL);
+    raise(sig);
+    return;
+  }
+  seen = 1;
+  sp_run_request_stop();
+}
+
+/** SIGTERM (a job's time limit), SIGINT (^C), SIGUSR1 (a scheduler's
+ *  warning): checkpoint at the end of the step in progress and stop (the
+ *  first one; a second ends the process). */
+static void catch_stop_signals(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGTERM, &sa, NULL);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGUSR1, &sa, NULL);
+}
+
+static int cmd_run(int argc, char **argv, int rank, int *stopped) {
   const char *scene_path = NULL, *out_dir = NULL;
+  sp_restart restart = {0};
   const char **sets = calloc(argc > 0 ? argc : 1, sizeof(char *));
   int n_set = 0, quiet = 0;
   SP_CHECK(sets, SP_ERR_MEMORY, "out of memory");
@@ -117,6 +158,9 @@ static int cmd_run(int argc, char **argv, int rank) {
   for (int i = 0; i < argc && rc == SP_OK; ++i) {
     if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) out_dir = argv[++i];
     else if (strcmp(argv[i], "--quiet") == 0) quiet = 1;
+    else if (strcmp(argv[i], "--restart") == 0 && i + 1 < argc) restart.checkpoint = argv[++i];
+    else if (strcmp(argv[i], "--resume") == 0 && i + 1 < argc) restart.resume_dir = argv[++i];
+    else if (strcmp(argv[i], "--restart-as-initial") == 0) restart.as_initial = 1;
     else if (strcmp(argv[i], "--set") == 0 && i + 1 < argc) sets[n_set++] = argv[++i];
     else if (argv[i][0] == '-')
       rc = sp_error_set(SP_ERR_INPUT, "unknown option or missing value: %s", argv[i]);
@@ -124,6 +168,12 @@ static int cmd_run(int argc, char **argv, int rank) {
     else rc = sp_error_set(SP_ERR_INPUT, "more than one scene file: %s and %s", scene_path, argv[i]);
   }
   if (rc == SP_OK && !scene_path) rc = sp_error_set(SP_ERR_INPUT, "softpack run needs a scene file");
+  if (rc == SP_OK && restart.checkpoint && restart.resume_dir)
+    rc = sp_error_set(SP_ERR_INPUT, "--restart and --resume: give one");
+  if (rc == SP_OK && restart.as_initial && !restart.checkpoint && !restart.resume_dir)
+    rc = sp_error_set(SP_ERR_INPUT, "--restart-as-initial needs --restart or --resume");
+  if (rc == SP_OK && !out_dir && restart.resume_dir && !restart.as_initial)
+    out_dir = restart.resume_dir; /* continue where it ran */
   char out_default[4096];
   if (rc == SP_OK && !out_dir) {
     default_out_dir(scene_path, out_default, sizeof out_default);
@@ -133,10 +183,13 @@ static int cmd_run(int argc, char **argv, int rank) {
   /* a progress line only where someone watches: on a terminal, not --quiet */
   progress prog = {.rank = rank};
   const int show = !quiet && isatty(fileno(stderr));
-  if (rc == SP_OK)
-    rc = sp_run_file(scene_path, n_set, sets, out_dir, MPI_COMM_WORLD,
-                     show ? draw_progress : NULL, &prog, &sum);
+  if (rc == SP_OK) {
+    catch_stop_signals();
+    rc = sp_run_file_restart(scene_path, n_set, sets, out_dir, &restart, MPI_COMM_WORLD,
+                             show ? draw_progress : NULL, &prog, &sum);
+  }
   if (prog.drawn) fputc('\n', stderr);
+  *stopped = rc == SP_OK && sum.stopped == SP_STOPPED_SIGNAL;
   /* the summary means something only after a run that succeeded */
   if (rc == SP_OK && rank == 0) print_summary(&sum, out_dir);
   free(sets);
@@ -161,7 +214,7 @@ int main(int argc, char **argv) {
   hold_threads();
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  int rc = SP_OK;
+  int rc = SP_OK, stopped = 0;
   if (argc >= 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
     if (rank == 0) usage(stdout);
   } else if ((argc >= 2 && strcmp(argv[1], "--version") == 0) ||
@@ -175,14 +228,14 @@ int main(int argc, char **argv) {
   } else if (argc >= 2 && strcmp(argv[1], "keys") == 0) {
     if (rank == 0) sp_scene_print_keys(stdout);
   } else if (argc >= 2 && strcmp(argv[1], "run") == 0) {
-    rc = cmd_run(argc - 2, argv + 2, rank);
+    rc = cmd_run(argc - 2, argv + 2, rank, &stopped);
   } else if (argc >= 2 && strcmp(argv[1], "check-jacobian") == 0) {
     rc = sp_check_jacobian_command(argc - 2, argv + 2);
   } else {
     rc = sp_error_set(SP_ERR_INPUT, "unknown command%s%s (try softpack --help)",
                       argc >= 2 ? ": " : "", argc >= 2 ? argv[1] : "");
   }
-  const int status = sp_error_exit_status(rc);
+  const int status = stopped ? SP_EXIT_STOPPED : sp_error_exit_status(rc);
   if (rc != SP_OK) {
     /* One rank's failure ends all ranks, never a hang. Every failing rank
      * prints its message: an error seen by rank > 0 alone is not lost. */

@@ -49,6 +49,27 @@ int sp_run_text(const char *name, const char *text, size_t len, int n_set,
                 const char *const *set, const char *out_dir, MPI_Comm comm,
                 sp_step_callback on_step, void *user, sp_run_summary *summary);
 
+/** How `softpack run` continues a run (docs/restart.md). */
+typedef struct {
+  const char *checkpoint; /**< --restart FILE: continue from this checkpoint */
+  const char *resume_dir; /**< --resume DIR: from DIR's newest valid checkpoint */
+  int as_initial;         /**< --restart-as-initial: the checkpoint's fields and
+                               cells as a new run's initial state (t = 0) */
+} sp_restart;
+
+/**
+ * @brief sp_run_file continued from a checkpoint (@p restart NULL or with
+ *        neither file nor directory: a new run). The scene (with its
+ *        overrides) must be the checkpoint's but for time.t_end,
+ *        time.max_steps and output.*, unless as_initial; else
+ *        SP_ERR_INPUT naming the first key that differs, nothing written.
+ *        Checkpoints of this run are written as the scene says
+ *        (output.checkpoint_*) and when sp_run_request_stop is called.
+ */
+int sp_run_file_restart(const char *path, int n_set, const char *const *set,
+                        const char *out_dir, const sp_restart *restart, MPI_Comm comm,
+                        sp_step_callback on_step, void *user, sp_run_summary *summary);
+
 #ifdef __cplusplus
 }
 #endif

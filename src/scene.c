@@ -64,13 +64,14 @@ typedef enum {
   SP_SEC_SOURCE,
   SP_SEC_LAYOUT,
   SP_SEC_SHAPE,
+  SP_SEC_INITIAL,
   SP_SEC_CELLS, /**< a sequence of cell mappings, not a mapping of scalars */
   SP_N_SECTIONS
 } sp_section;
 
 static const char *const sp_section_names[SP_N_SECTIONS] = {
     "mesh", "model", "time", "noise", "solver", "output", "division", "source",
-    "layout", "shape", "cells"};
+    "layout", "shape", "initial", "cells"};
 
 /** Scalar type of a key as the user sees it. */
 typedef enum {
@@ -78,11 +79,12 @@ typedef enum {
   SP_KEY_INT,   /**< int (written as an integer-valued number, 1e6 is fine) */
   SP_KEY_UINT,  /**< unsigned */
   SP_KEY_BOOL,  /**< int 0/1, written true/false (yes/no, on/off) */
-  SP_KEY_ENUM   /**< int, written as one of a list of words */
+  SP_KEY_ENUM,  /**< int, written as one of a list of words */
+  SP_KEY_PATH   /**< char[SP_SCENE_PATH_MAX], a file name ("": none) */
 } sp_key_type;
 
 static const char *const sp_key_type_names[] = {"float", "int", "uint",
-                                                 "bool", "enum"};
+                                                 "bool", "enum", "path"};
 
 /** How one end of an allowed range is closed. */
 typedef enum {
@@ -189,6 +191,11 @@ _Static_assert(sizeof(sp_linear_kind) == sizeof(int), "enum size");
 #define KEY_ENUM(sec, name, member, def, words, unit, meaning)                 \
   {sec, name, SP_KEY_ENUM, ENUM_MEMBER_OFFSET(sp_scene, member), def, 0,       \
    UNBOUNDED, UNBOUNDED, words, CYAML_ARRAY_LEN(words), unit, meaning}
+#define KEY_PATH(sec, name, member, meaning)                                    \
+  {sec, name, SP_KEY_PATH,                                                     \
+   offsetof(sp_scene, member) +                                                \
+       0 * sizeof(char[sizeof(((sp_scene *)0)->member) == SP_SCENE_PATH_MAX ? 1 : -1]), \
+   0.0, 0, UNBOUNDED, UNBOUNDED, NULL, 0, "-", meaning}
 #define CELL_FLOAT_REQUIRED(name, member, lo, hi, unit, meaning)               \
   {SP_SEC_CELLS, name, SP_KEY_FLOAT,                                           \
    MEMBER_OFFSET(sp_scene_cell, member, double), 0.0, 1, lo, hi, NULL, 0,      \
@@ -371,6 +378,20 @@ static const sp_key sp_keys[] = {
               UNBOUNDED, "T",
               "also write fields and pictures at every multiple of this time "
               "(steps land on them; 0: off)"),
+    KEY_BOOL(SP_SEC_OUTPUT, "timings", output.timings, 1, "-",
+             "energy.csv's wall-clock columns (seconds, assembly_s, ...): the "
+             "measured seconds, or zeros (false: two runs' logs compare byte "
+             "for byte)"),
+    KEY_INT(SP_SEC_OUTPUT, "checkpoint_every", output.checkpoint_every, 0,
+            AT_LEAST(0), AT_MOST(INT_MAX), "steps",
+            "write a checkpoint every this many steps (0: off; docs/restart.md)"),
+    KEY_FLOAT(SP_SEC_OUTPUT, "checkpoint_seconds", output.checkpoint_seconds, 0.0,
+              AT_LEAST(0.0), UNBOUNDED, "s",
+              "also write a checkpoint after this much wall-clock time since "
+              "the last one (0: off)"),
+    KEY_INT(SP_SEC_OUTPUT, "checkpoint_keep", output.checkpoint_keep, 2,
+            AT_LEAST(1), AT_MOST(1000000), "files",
+            "keep the newest this many checkpoints, delete older ones"),
     /* division */
     KEY_ENUM(SP_SEC_DIVISION, "criterion", division.criterion, SP_DIVIDE_NONE,
              sp_division_words, "-",
@@ -455,6 +476,22 @@ static const sp_key sp_keys[] = {
              "moments of the new state, linearised about c^n (stable for "
              "stiff moduli; 2 extra right-hand sides per cell in each Newton "
              "iteration's solve)"),
+    /* initial: the initial fields from files (src/initial.h) */
+    KEY_PATH(SP_SEC_INITIAL, "from", initial.from,
+             "start from the fields of a softpack checkpoint (.h5) or .vtu on the "
+             "same mesh instead of the cells' disks (docs/restart.md)"),
+    KEY_PATH(SP_SEC_INITIAL, "label_image", initial.label_image,
+             "start from a PNG label image: every colour but black (and "
+             "transparent) is one cell, smoothed to the equilibrium profile "
+             "(docs/restart.md)"),
+    KEY_FLOAT(SP_SEC_INITIAL, "x0", initial.x0, -0.5, UNBOUNDED, UNBOUNDED, "L",
+              "label_image: x of the image's left edge"),
+    KEY_FLOAT(SP_SEC_INITIAL, "y0", initial.y0, -0.25, UNBOUNDED, UNBOUNDED, "L",
+              "label_image: y of the image's bottom edge"),
+    KEY_FLOAT(SP_SEC_INITIAL, "x1", initial.x1, 0.5, UNBOUNDED, UNBOUNDED, "L",
+              "label_image: x of the image's right edge (> x0)"),
+    KEY_FLOAT(SP_SEC_INITIAL, "y1", initial.y1, 0.25, UNBOUNDED, UNBOUNDED, "L",
+              "label_image: y of the image's top edge (> y0)"),
     /* cells: one mapping per initial cell */
     CELL_FLOAT_REQUIRED("x", x, UNBOUNDED, UNBOUNDED, "L",
                         "centre x; the cell's disk must lie inside Omega"),
@@ -598,6 +635,9 @@ static const char *expectation(const sp_key *key, char *buf, size_t size) {
   case SP_KEY_ENUM:
     snprintf(buf, size, "one of %s", word_list(key, words, sizeof words));
     break;
+  case SP_KEY_PATH:
+    snprintf(buf, size, "a file name of at most %d characters", SP_SCENE_PATH_MAX - 1);
+    break;
   default:
     range_text(key, range, sizeof range);
     if (key->lower.kind != SP_UNBOUNDED && key->upper.kind != SP_UNBOUNDED)
@@ -641,10 +681,53 @@ static int value_allowed(const sp_key *key, double value) {
 static void store_value(void *base, const sp_key *key, double value) {
   char *member = (char *)base + key->offset;
   switch (key->type) {
+  case SP_KEY_PATH: member[0] = '\0'; break; /* the default: none */
   case SP_KEY_FLOAT: *(double *)member = value; break;
   case SP_KEY_UINT: *(unsigned *)member = (unsigned)value; break;
   default: *(int *)member = (int)value; break; /* int, bool, enum */
   }
+}
+
+/** The member of @p base (sp_scene or sp_scene_cell) @p key names. */
+static double load_value(const void *base, const sp_key *key) {
+  const char *member = (const char *)base + key->offset;
+  switch (key->type) {
+  case SP_KEY_PATH: return 0.0; /* compared as text */
+  case SP_KEY_FLOAT: return *(const double *)member;
+  case SP_KEY_UINT: return *(const unsigned *)member;
+  default: return *(const int *)member; /* int, bool, enum */
+  }
+}
+
+int sp_scene_first_difference(const sp_scene *a, const sp_scene *b,
+                              int (*skip)(const char *key), char *buf, size_t size) {
+  for (size_t i = 0; i < SP_N_KEYS; ++i) {
+    const sp_key *key = &sp_keys[i];
+    if (key->section == SP_SEC_CELLS) continue;
+    key_path(key, -1, buf, size);
+    if (skip && skip(buf)) continue;
+    if (key->type == SP_KEY_PATH) {
+      if (strcmp((const char *)a + key->offset, (const char *)b + key->offset) != 0) return 1;
+    } else if (memcmp(&(double){load_value(a, key)}, &(double){load_value(b, key)},
+                      sizeof(double))) {
+      return 1;
+    }
+  }
+  if (a->n_cells != b->n_cells) {
+    snprintf(buf, size, "cells");
+    return !(skip && skip(buf));
+  }
+  for (int c = 0; c < a->n_cells; ++c)
+    for (size_t i = 0; i < SP_N_KEYS; ++i) {
+      const sp_key *key = &sp_keys[i];
+      if (key->section != SP_SEC_CELLS) continue;
+      key_path(key, c + 1, buf, size);
+      if (skip && skip(buf)) continue;
+      if (memcmp(&(double){load_value(&a->cells[c], key)},
+                 &(double){load_value(&b->cells[c], key)}, sizeof(double)))
+        return 1;
+    }
+  return 0;
 }
 
 static void store_defaults(void *base, sp_section section) {
@@ -664,6 +747,15 @@ static int store_slot(void *base, const sp_key *key, const void *slot,
   char path[SP_TEXT], expected[SP_LIST_TEXT];
   double value;
   const char *text = NULL;
+  if (key->type == SP_KEY_PATH) {
+    text = slot;
+    if (strlen(text) >= SP_SCENE_PATH_MAX)
+      return sp_error_set(SP_ERR_INPUT, "%s: %s: expected %s, got one of %zu", where,
+                          key_path(key, cell, path, sizeof path),
+                          expectation(key, expected, sizeof expected), strlen(text));
+    strcpy((char *)base + key->offset, text);
+    return SP_OK;
+  }
   if (key->type == SP_KEY_BOOL || key->type == SP_KEY_ENUM) {
     value = *(const int *)slot;
   } else {
@@ -1046,11 +1138,22 @@ static int apply_raw(sp_scene *scene, const sp_raw_scene *raw,
     if (slots && slots[key_slot(key)])
       SP_CALL(store_slot(scene, key, slots[key_slot(key)], file, -1));
   }
-  /* libcyaml loads "cells: []", "cells:" and no cells key alike */
-  SP_CHECK(raw->n_cells > 0, SP_ERR_INPUT,
-           "%s: cells: no cells given (the key is missing or its list is "
-           "empty); a scene needs at least one cell",
-           file);
+  /* file names in the scene are relative to the scene file's directory */
+  const char *slash = strrchr(file, '/');
+  for (size_t i = 0; slash && i < SP_N_KEYS; ++i) {
+    const sp_key *key = &sp_keys[i];
+    char *value = (char *)scene + key->offset;
+    if (key->type != SP_KEY_PATH || !value[0] || value[0] == '/') continue;
+    char joined[SP_SCENE_PATH_MAX + 1];
+    const int n = snprintf(joined, sizeof joined, "%.*s/%s", (int)(slash - file), file, value);
+    char path[SP_TEXT];
+    SP_CHECK(n > 0 && n < SP_SCENE_PATH_MAX, SP_ERR_INPUT,
+             "%s: %s: the file name with the scene's directory is longer than %d characters",
+             file, key_path(key, -1, path, sizeof path), SP_SCENE_PATH_MAX - 1);
+    memcpy(value, joined, (size_t)n + 1);
+  }
+  /* libcyaml loads "cells: []", "cells:" and no cells key alike; none is
+   * right only with initial.from or initial.label_image (check_initial) */
   SP_ALLOC(scene->cells, raw->n_cells);
   scene->n_cells = (int)raw->n_cells;
   size_t n_cell_keys = section_key_count(SP_SEC_CELLS);
@@ -1152,6 +1255,30 @@ static int apply_override(sp_scene *scene, const char *arg) {
 /* ------------------------------------------------------------------------ */
 /* Checks across keys                                                       */
 /* ------------------------------------------------------------------------ */
+
+/** Cells, or initial fields from a file: one of them. */
+static int check_initial(const sp_scene *scene, const char *file) {
+  const sp_scene_initial *in = &scene->initial;
+  const int from = in->from[0] != '\0', image = in->label_image[0] != '\0';
+  SP_CHECK(scene->n_cells > 0 || from || image, SP_ERR_INPUT,
+           "%s: cells: no cells given (the key is missing or its list is "
+           "empty); a scene needs at least one cell, or initial.from or "
+           "initial.label_image",
+           file);
+  SP_CHECK(!(from && image), SP_ERR_INPUT,
+           "%s: initial.label_image: expected none with initial.from (give one "
+           "source of initial fields), got '%s'", file, in->label_image);
+  SP_CHECK(scene->n_cells == 0 || !(from || image), SP_ERR_INPUT,
+           "%s: cells: expected none with initial.%s (the file gives the cells), got %d",
+           file, from ? "from" : "label_image", scene->n_cells);
+  SP_CHECK(!image || in->x1 > in->x0, SP_ERR_INPUT,
+           "%s: initial.x1: expected a number > initial.x0 = %.15g, got %.15g", file,
+           in->x0, in->x1);
+  SP_CHECK(!image || in->y1 > in->y0, SP_ERR_INPUT,
+           "%s: initial.y1: expected a number > initial.y0 = %.15g, got %.15g", file,
+           in->y0, in->y1);
+  return SP_OK;
+}
 
 static int check_time_and_mesh(const sp_scene *scene, const char *file) {
   const sp_scene_time *t = &scene->time;
@@ -1279,9 +1406,14 @@ static int fill_scene(sp_scene *scene, const char *path, const char *text,
   snprintf(where, sizeof where, "%s%s", path,
            n_set ? " (with its --set overrides)" : "");
   SP_CALL(check_time_and_mesh(scene, where));
+  SP_CALL(check_initial(scene, where));
   SP_CALL(check_cells(scene, where));
   SP_CALL(check_sizes(scene, where));
   return SP_OK;
+}
+
+int sp_scene_read_file(const char *path, char **text, size_t *len) {
+  return read_file(path, text, len);
 }
 
 static int load_scene(const char *path, const char *text, size_t len,
@@ -1323,9 +1455,13 @@ void sp_scene_print_keys(FILE *out) {
     const sp_key *key = &sp_keys[i];
     if (key->type == SP_KEY_BOOL || key->type == SP_KEY_ENUM)
       word_list(key, range, sizeof range);
+    else if (key->type == SP_KEY_PATH)
+      snprintf(range, sizeof range, "a file");
     else
       range_text(key, range, sizeof range);
-    if (key->required)
+    if (key->type == SP_KEY_PATH)
+      snprintf(fallback, sizeof fallback, "none");
+    else if (key->required)
       snprintf(fallback, sizeof fallback, "required");
     else if (key->type == SP_KEY_BOOL || key->type == SP_KEY_ENUM)
       snprintf(fallback, sizeof fallback, "%s", word_of(key, key->fallback));

@@ -116,6 +116,11 @@ typedef struct {
   int picture_width;  /**< picture width in pixels */
   double interval;    /**< also write at multiples of this time (0: off);
                            steps land on those times */
+  int timings;        /**< 1: energy.csv's wall-clock columns hold the
+                           seconds; 0: zeros (runs compare byte for byte) */
+  int checkpoint_every;      /**< a checkpoint every this many steps (0: off) */
+  double checkpoint_seconds; /**< ... and after this much wall time (0: off) */
+  int checkpoint_keep;       /**< the newest this many checkpoints are kept */
 } sp_scene_output;
 
 typedef enum {
@@ -174,6 +179,17 @@ typedef struct {
   sp_shape_scheme scheme; /**< explicit (the paper) or linearised implicit */
 } sp_scene_shape;
 
+/** Longest file path a scene key holds. */
+#define SP_SCENE_PATH_MAX 1024
+
+/** initial: initial fields from files instead of the cells' disks
+ *  (src/initial.h). */
+typedef struct {
+  char from[SP_SCENE_PATH_MAX];        /**< a softpack checkpoint (.h5) or .vtu ("": none) */
+  char label_image[SP_SCENE_PATH_MAX]; /**< a PNG of labels, one colour a cell ("": none) */
+  double x0, y0, x1, y1;               /**< label_image: the box of Omega it covers */
+} sp_scene_initial;
+
 typedef struct sp_scene {
   sp_scene_mesh mesh;
   sp_scene_model model;
@@ -185,7 +201,8 @@ typedef struct sp_scene {
   sp_scene_source source;
   sp_scene_shape shape;
   sp_scene_layout layout;
-  int n_cells;
+  sp_scene_initial initial;
+  int n_cells;         /**< 0 when initial.from or initial.label_image gives the cells */
   sp_scene_cell *cells;
 } sp_scene;
 
@@ -208,6 +225,19 @@ int sp_scene_load(const char *path, int n_set, const char *const *set,
  */
 int sp_scene_load_text(const char *name, const char *text, size_t len,
                        int n_set, const char *const *set, sp_scene **out);
+
+/**
+ * @brief The first key whose value differs between @p a and @p b, skipping
+ *        keys @p skip says yes to (NULL: none), as "section.key" or
+ *        "cells[i].key" into @p buf ("cells" when the counts differ).
+ * @return 1 if a difference was found, 0 if the scenes agree
+ */
+int sp_scene_first_difference(const sp_scene *a, const sp_scene *b,
+                              int (*skip)(const char *key), char *buf, size_t size);
+
+/** @brief A scene file's text (malloc'd, NUL-terminated, @p len bytes
+ *         without the NUL), for sp_scene_load_text. */
+int sp_scene_read_file(const char *path, char **text, size_t *len);
 
 /** @brief Interface width d = sqrt(kappa / (2 alpha)) of the scene's model. */
 double sp_scene_interface_width(const sp_scene *scene);

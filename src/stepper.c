@@ -1,6 +1,7 @@
 #include "stepper.h"
 
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,11 +9,14 @@
 #include <unistd.h>
 
 #include "cells.h"
+#include "checkpoint.h"
 #include "division.h"
 #include "dt_control.h"
 #include "error.h"
+#include "initial.h"
 #include "layout.h"
 #include "output.h"
+#include "run_state.h"
 #include "partition.h"
 #include "render.h"
 #include "shape.h"
@@ -84,44 +88,6 @@ static double wall_clock(void) {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-/** Everything one run holds. */
-typedef struct {
-  const sp_scene *scene;
-  sp_mesh *mesh;
-  sp_layout *layout;
-  sp_solver solver;
-  sp_output output;
-  sp_model_params model;
-  double *state, *state_old; /* the state, and c^n of the step in progress */
-  double *state_eff;  /* the step's backward-Euler form of c^n (BDF2: c_hat) */
-  double *scratch;    /* the error estimate's extrapolation */
-  /* the past states (time scheme, error estimate, solver.predictor) on the
-   * current layout; emptied by a division */
-  sp_history hist;
-  sp_dt_control dtc;  /* how dt is chosen: dt_control.h */
-  sp_cell_obs *obs;
-  double *energy_t, *energy_total; /* the energy history for energy.png */
-  int n_energy, cap_energy;
-  double *division_t; /* division times, marked on energy.png */
-  int n_divisions;
-  int rank, n_ranks;
-  const char *out_dir;   /* the output directory (every rank writes its piece) */
-  /* the cell registry */
-  sp_cell_birth *birth;
-  int *source_on;
-  int *division_skipped; /* due but no field left: reported once */
-  unsigned char *divided_now; /* parent or daughter of a division this step:
-                                 its support may shrink (layout.shrink) */
-  double *source;        /* per pair, from c^n */
-  int n_max;             /* N_max */
-  sp_support support;    /* local supports (NULL: full) */
-  sp_run_summary *sum;
-  sp_division_params division;
-  MPI_Comm comm;
-  sp_step_callback on_step; /* may be NULL */
-  void *on_step_user;
-  double t_start;           /* wall clock at the run's start */
-} sp_run;
 
 /** Observables with the mass replaced by the core mass (c >= threshold):
  *  what division and source decisions see. */
@@ -227,9 +193,29 @@ static int alloc_step_buffers(sp_run *run) {
   return SP_OK;
 }
 
-/** Make (layout, state) the run's own, resize the per-pair buffers and
- *  hand the layout to the solver (the history is the caller's to move). */
-static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
+/** What a layout change does to the time scheme's history. */
+typedef enum {
+  SP_HISTORY_CARRY, /**< a support change: the past states move with (cell,
+                         node) as increments, 0 on new pairs */
+  SP_HISTORY_RESET  /**< a division, the initial layout: the scheme starts over */
+} sp_history_move;
+
+/** The one place the run's layout changes: (layout, state) become the
+ *  run's own (taken over, freed on failure too), the history moves as
+ *  @p how says, the per-pair buffers are resized and the solver gets the
+ *  layout. */
+static int adopt_layout(sp_run *run, sp_layout *layout, double *state, sp_history_move how) {
+  if (how == SP_HISTORY_CARRY) {
+    const int rc =
+        sp_history_transfer(&run->hist, run->mesh, run->layout, run->state, layout, state);
+    if (rc != SP_OK) {
+      sp_layout_destroy(&layout);
+      free(state);
+      return rc;
+    }
+  } else {
+    sp_history_reset(&run->hist);
+  }
   sp_layout_destroy(&run->layout);
   free(run->state);
   run->layout = layout;
@@ -252,14 +238,7 @@ static int update_supports(sp_run *run, sp_energy_parts *after) {
                              always ? NULL : run->divided_now, &layout, &state, &correction,
                              &dropped));
   memset(run->divided_now, 0, (size_t)run->layout->n_cells);
-  /* the past states move with (cell, node) as increments, 0 on new pairs */
-  int rc = sp_history_transfer(&run->hist, run->mesh, run->layout, run->state, layout, state);
-  if (rc != SP_OK) {
-    sp_layout_destroy(&layout);
-    free(state);
-    return rc;
-  }
-  SP_CALL(adopt_layout(run, layout, state));
+  SP_CALL(adopt_layout(run, layout, state, SP_HISTORY_CARRY));
   SP_CALL(state_energy(run, after));
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            run->scene->division.observe_threshold, run->obs));
@@ -319,8 +298,7 @@ static int divide_cell(sp_run *run, int parent, double t, int step) {
     sp_layout_destroy(&new_layout);
     return rc;
   }
-  sp_history_reset(&run->hist); /* the scheme starts over after a division */
-  SP_CALL(adopt_layout(run, new_layout, new_state));
+  SP_CALL(adopt_layout(run, new_layout, new_state, SP_HISTORY_RESET));
   SP_CALL(grow_array((void **)&run->obs, sizeof *run->obs, n, n + 1));
   SP_CALL(grow_array((void **)&run->birth, sizeof *run->birth, n, n + 1));
   SP_CALL(grow_array((void **)&run->source_on, sizeof *run->source_on, n, n + 1));
@@ -485,6 +463,51 @@ static double mass_crossing(const sp_run *run, double t_old, double t_new,
   return theta;
 }
 
+/** Set by sp_run_request_stop (a signal handler): checkpoint and stop. */
+static volatile sig_atomic_t stop_requested;
+
+void sp_run_request_stop(void) { stop_requested = 1; }
+
+/** After an accepted step: write a checkpoint if one is due (every
+ *  output.checkpoint_every steps, output.checkpoint_seconds since the last)
+ *  or a stop was requested on any rank (*signalled = 1). All ranks decide
+ *  alike; rank 0 writes. */
+static int checkpoint_if_due(sp_run *run, int *signalled) {
+  const sp_scene_output *o = &run->scene->output;
+  int want[2] = {stop_requested != 0,
+                 o->checkpoint_seconds > 0 &&
+                     wall_clock() - run->t_checkpoint >= o->checkpoint_seconds};
+  if (run->n_ranks > 1) /* a signal may reach one rank; clocks differ */
+    MPI_Allreduce(MPI_IN_PLACE, want, 2, MPI_INT, MPI_MAX, run->comm);
+  *signalled = want[0];
+  if (!(want[0] || want[1] || (o->checkpoint_every > 0 && run->step % o->checkpoint_every == 0)))
+    return SP_OK;
+  int rc = SP_OK;
+  char path[4096] = "";
+  const double t0 = wall_clock();
+  if (run->rank == 0) rc = sp_checkpoint_write(run, run->out_dir, path, sizeof path);
+  run->sum->t_checkpoints += wall_clock() - t0;
+  ++run->sum->checkpoints;
+  if (run->n_ranks > 1) { /* every rank learns whether it was written */
+    int failed = rc != SP_OK;
+    MPI_Bcast(&failed, 1, MPI_INT, 0, run->comm);
+    if (failed && run->rank != 0)
+      rc = sp_error_set(SP_ERR_IO, "rank 0 could not write a checkpoint (see its message)");
+  }
+  run->t_checkpoint = wall_clock();
+  /* the next factorisation from scratch, as in a run continued from here
+   * (SuperLU_DIST's row permutation would otherwise come from an earlier
+   * matrix); sets a flag only */
+  if (rc == SP_OK && sp_solver_refactor_next(run->solver) != 0)
+    rc = sp_error_set(SP_ERR_INTERNAL, "solver: %s", sp_solver_last_error(run->solver));
+  if (rc == SP_OK && want[0] && run->rank == 0) {
+    if (isatty(fileno(stderr))) fputs("\r\033[K", stderr);
+    fprintf(stderr, "softpack: stopped on a signal after step %d (t = %.6g): checkpoint %s\n",
+            run->step, run->t, path);
+  }
+  return rc;
+}
+
 /** The time loop proper. */
 static int run_steps(sp_run *run, sp_run_summary *sum) {
   const sp_scene_time *tc = &run->scene->time;
@@ -494,13 +517,17 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       adaptive || scheme == SP_SCHEME_BDF2 || run->scene->solver.predictor == SP_PREDICT_LINEAR;
   sp_dt_params dtp;
   sp_dt_params_from_scene(run->scene, &dtp);
-  sp_dt_init(&run->dtc, &dtp, first_dt(run));
-  double t = 0.0;
-  int step = 0;
+  double t = run->t;
+  int step = run->step;
+  if (run->restarted) { /* the controller's state came from the checkpoint */
+    run->dtc.p = dtp;
+  } else {
+    sp_dt_init(&run->dtc, &dtp, first_dt(run));
+    sum->dt_smallest = adaptive ? tc->dt_max : tc->dt;
+    SP_CALL(record_energy(run, 0, t, 0.0, 0, NULL, NULL));
+    SP_CALL(write_snapshot(run, 0, t));
+  }
   double *core_mass_old = NULL;
-  sum->dt_smallest = adaptive ? tc->dt_max : tc->dt;
-  SP_CALL(record_energy(run, 0, t, 0.0, 0, NULL, NULL));
-  SP_CALL(write_snapshot(run, 0, t));
   const double t_tol = 1e-12 * tc->t_end;
   sp_shape_coef *shape_coef = NULL; /* per cell, refreshed before each step */
   sp_cell_obs *obs_new = NULL;      /* adaptive, mass criterion: see mass_crossing */
@@ -606,6 +633,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     const double t_old = t;
     t = lands ? t_event : t + dt_try;
     ++step;
+    run->t = t;
+    run->step = step;
     sp_dt_accepted(&run->dtc, dt_try, err);
     seconds.error_estimate = err;
     if (want_history) {
@@ -660,6 +689,9 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     }
     const int failed_before = seconds.failed_attempts;
     seconds.step = wall_clock() - step_start;
+    if (!run->scene->output.timings) /* logs that compare byte for byte */
+      seconds.step = seconds.assembly = seconds.factorisation = seconds.solves =
+          seconds.supports = 0;
     /* the state is the one update_supports left, if it ran */
     rc = record_energy(run, step, t, dt_try, report.newton_its, &seconds,
                        have_energy ? &energy_after_supports : NULL);
@@ -679,11 +711,19 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       stop = run->on_step(&info, run->on_step_user) != 0;
       if (run->n_ranks > 1) /* any rank's stop stops every rank */
         MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, run->comm);
-      sum->stopped = stop;
+      sum->stopped = stop ? SP_STOPPED_CALLBACK : 0;
     }
     if (step % run->scene->output.every == 0 || ends || stop || n_divided ||
         (lands && on_output_time(run->scene, t)))
       rc = write_snapshot(run, step, t);
+    if (rc == SP_OK && !ends) { /* checkpoints: due, or a signal asked for one */
+      int signalled = 0;
+      rc = checkpoint_if_due(run, &signalled);
+      if (rc == SP_OK && signalled) {
+        sum->stopped = SP_STOPPED_SIGNAL;
+        break;
+      }
+    }
     if (stop) break;
   }
   sum->n_cells = run->layout->n_cells;
@@ -742,19 +782,46 @@ static int renumber_rcb(sp_run *run) {
   return rc;
 }
 
-static int run_setup(sp_run *run, MPI_Comm comm) {
+/** The registry of a new run from the fields: every cell born at t = 0
+ *  with its core mass and moments now, its source on; N_max. */
+static int new_registry(sp_run *run) {
+  const sp_scene_division *dv = &run->scene->division;
+  const int n = run->layout->n_cells;
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold, run->obs));
+  sp_cell_obs *core;
+  SP_ALLOC(core, n);
+  core_view(run->obs, n, core);
+  for (int k = 0; k < n; ++k) {
+    run->birth[k] = sp_cell_birth_make(0.0, &core[k], 0);
+    run->source_on[k] = 1;
+    run->division_skipped[k] = 0;
+    run->divided_now[k] = 0;
+  }
+  free(core);
+  run->n_max = dv->max_cells > 0 ? dv->max_cells
+               : sp_division_max_cells(sp_mesh_region_area(run->mesh, SP_REGION_OMEGA),
+                                       run->birth[0].birth_mass);
+  return SP_OK;
+}
+
+static int run_setup(sp_run *run, MPI_Comm comm, const sp_run_start *start) {
   const sp_scene *scene = run->scene;
   MPI_Comm_rank(comm, &run->rank);
   MPI_Comm_size(comm, &run->n_ranks);
   SP_CALL(sp_mesh_from_scene(scene, &run->mesh));
-  SP_CALL(sp_layout_create_full(run->mesh->n_nodes, scene->n_cells, &run->layout));
+  /* The initial cells: the scene's disks or a file's (initial.h). A
+   * checkpoint's replace them below; a scene without cells (initial.from a
+   * checkpoint) has one placeholder cell until then. */
+  const int placeholder = start && start->checkpoint && scene->n_cells == 0;
+  int n = 1;
+  if (!placeholder) SP_CALL(sp_initial_cell_count(scene, &n));
+  SP_CALL(sp_layout_create_full(run->mesh->n_nodes, n, &run->layout));
   sp_solver_options opt;
   sp_solver_options_from_scene(scene, &opt);
   sp_model_from_scene(scene, &run->model);
   if (sp_solver_create(comm, &opt, &run->solver) != 0)
     return sp_error_set(SP_ERR_INPUT, "solver: %s", sp_solver_last_error(run->solver));
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
-  const int n = scene->n_cells;
   SP_ALLOC(run->state, n_values);
   SP_CALL(alloc_step_buffers(run));
   SP_ALLOC(run->obs, n);
@@ -762,37 +829,49 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   SP_ALLOC(run->source_on, n);
   SP_ALLOC(run->division_skipped, n);
   SP_ALLOC(run->divided_now, n);
-  SP_CALL(sp_cells_initial_state(scene, run->mesh, run->layout, run->state));
+  if (!placeholder) SP_CALL(sp_initial_state(scene, run->mesh, run->layout, run->state));
   SP_CALL(renumber_rcb(run));
-  /* the registry: every initial cell is born at t = 0 */
-  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
-                           scene->division.observe_threshold, run->obs));
-  sp_cell_obs *core;
-  SP_ALLOC(core, n);
-  core_view(run->obs, n, core);
-  for (int k = 0; k < n; ++k) {
-    run->birth[k] = sp_cell_birth_make(0.0, &core[k], 0);
-    run->source_on[k] = 1;
-  }
-  free(core);
+  if (placeholder) /* what decides on local supports: the checkpoint's cells */
+    sp_checkpoint_cells(start->checkpoint, &n, &run->n_max);
+  else SP_CALL(new_registry(run));
+  /* use_initial_mass: the first initial cell's birth mass (the same for a
+   * run continued from a checkpoint, whose scene has the same cells) */
+  double reference_mass = run->birth[0].birth_mass;
   const sp_scene_division *dv = &scene->division;
-  run->n_max = dv->max_cells > 0 ? dv->max_cells
-               : sp_division_max_cells(sp_mesh_region_area(run->mesh, SP_REGION_OMEGA),
-                                       run->birth[0].birth_mass);
   const sp_scene_layout *ly = &scene->layout;
   const int can_divide = dv->criterion != SP_DIVIDE_NONE;
   const int local = ly->support == SP_SUPPORT_LOCAL ||
                     (ly->support == SP_SUPPORT_AUTO &&
                      (n > SP_AUTO_LOCAL_CELLS || (can_divide && run->n_max > SP_AUTO_LOCAL_CELLS)));
   if (local) {
-    /* The initial fields are cut to the initial supports: background and
-     * noise exist only there (docs/local-support.md). */
     const double d = sp_scene_interface_width(scene);
     sp_support_params sp = {.margin = ly->margin * d, .core_threshold = ly->core_threshold,
                             .grow_threshold = ly->grow_threshold, .band = ly->band * d,
                             .alpha = run->model.alpha, .lambda = run->model.lambda,
                             .lambda_b = run->model.lambda_b};
     SP_CALL(sp_support_create(run->mesh, &sp, &run->support));
+  }
+  if (start && start->checkpoint) { /* the layout and state (and more) saved */
+    sp_output_field *fields = NULL;
+    int n_fields = 0;
+    int rc = sp_checkpoint_restore(start->checkpoint, run, start->as_initial, &fields, &n_fields);
+    if (rc == SP_OK && start->as_initial) free(fields);
+    else {
+      run->fields = fields;
+      run->n_fields = n_fields;
+    }
+    SP_CALL(rc);
+    run->restarted = !start->as_initial;
+    SP_CALL(alloc_step_buffers(run));
+    SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
+    if (start->as_initial) { /* observes too */
+      SP_CALL(new_registry(run));
+      reference_mass = run->birth[0].birth_mass;
+    } else SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold,
+                                  run->obs));
+  } else if (local) {
+    /* The initial fields are cut to the initial supports: background and
+     * noise exist only there (docs/local-support.md). */
     unsigned char *mask;
     SP_ALLOC(mask, (size_t)run->mesh->n_nodes * n);
     sp_layout *layout = NULL;
@@ -806,7 +885,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
       return sp_error_set(SP_ERR_MEMORY, "out of memory for the local layout");
     }
     sp_layout_transfer(run->layout, run->state, layout, state, 0.0);
-    SP_CALL(adopt_layout(run, layout, state));
+    SP_CALL(adopt_layout(run, layout, state, SP_HISTORY_RESET));
     SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold, run->obs));
   } else {
     SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
@@ -817,7 +896,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   run->division = (sp_division_params){
       .criterion = dv->criterion == SP_DIVIDE_BY_AGE ? SP_DIVIDE_AGE : SP_DIVIDE_MASS,
       .age = dv->t_div, .mass_ratio = dv->mass_ratio,
-      .reference_mass = dv->use_initial_mass ? run->birth[0].birth_mass : 0.0,
+      .reference_mass = dv->use_initial_mass ? reference_mass : 0.0,
       .tolerance = scene->time.control == SP_CONTROL_ADAPTIVE ? SP_MASS_LANDING_TOLERANCE : 0.0};
   return SP_OK;
 }
@@ -829,13 +908,35 @@ int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
 
 int sp_stepper_run_with(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
                         sp_step_callback on_step, void *user, sp_run_summary *summary) {
+  return sp_stepper_run_from(scene, NULL, out_dir, comm, on_step, user, summary);
+}
+
+int sp_stepper_run_from(const sp_scene *scene, const sp_run_start *start, const char *out_dir,
+                        MPI_Comm comm, sp_step_callback on_step, void *user,
+                        sp_run_summary *summary) {
   sp_run_summary sum = {0};
   const double t0 = wall_clock();
   sp_run run = {.scene = scene, .sum = &sum, .out_dir = out_dir, .comm = comm,
-                .on_step = on_step, .on_step_user = user, .t_start = t0};
-  int rc = run_setup(&run, comm);
+                .on_step = on_step, .on_step_user = user, .t_start = t0, .t_checkpoint = t0};
+  if (start) {
+    run.scene_text = start->scene_text;
+    run.scene_len = start->scene_len;
+    run.n_set = start->n_set;
+    run.set = start->set;
+  }
+  stop_requested = 0;
+  int rc = run_setup(&run, comm, start);
   /* Only now, with the input known good, does anything get written. */
-  if (rc == SP_OK && run.rank == 0) rc = sp_output_open(out_dir, &run.output);
+  if (rc == SP_OK && run.rank == 0) {
+    if (run.restarted) { /* the logs cut back to the checkpoint's step */
+      sp_checkpoint_remove_after(out_dir, run.step);
+      rc = sp_output_resume(out_dir, run.step, run.n_fields, run.fields, &run.output);
+    } else {
+      rc = sp_output_open(out_dir, &run.output);
+    }
+  }
+  free(run.fields);
+  run.fields = NULL;
   if (run.n_ranks > 1) { /* the other ranks write pieces into rank 0's directory */
     int failed = rc != SP_OK, any_failed = 0;
     MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, comm);

@@ -46,8 +46,15 @@ typedef struct {
                                    energy at a support change (0 if none
                                    rose) */
   long unknowns_max;   /**< largest number of unknowns of a step */
-  int stopped;         /**< 1 if a step callback stopped the run early */
+  int checkpoints;     /**< checkpoints written (output.checkpoint_*, signals) */
+  double t_checkpoints; /**< seconds spent writing them (rank 0) */
+  int stopped;         /**< SP_STOPPED_CALLBACK or SP_STOPPED_SIGNAL if the run
+                            stopped early, else 0 */
 } sp_run_summary;
+
+/** Why a run stopped before t_end (sp_run_summary.stopped). */
+enum { SP_STOPPED_CALLBACK = 1, /**< a step callback returned non-zero */
+       SP_STOPPED_SIGNAL = 2    /**< sp_run_request_stop: a checkpoint was written */ };
 
 /** What a step callback sees after each accepted step (the same on every
  *  MPI rank). */
@@ -95,6 +102,36 @@ int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
  *         accepted step with @p user. */
 int sp_stepper_run_with(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
                         sp_step_callback on_step, void *user, sp_run_summary *summary);
+
+/** How a run starts: from the scene's initial cells (checkpoint NULL), or
+ *  from a checkpoint (checkpoint.h) opened by the caller, whose scene the
+ *  caller checked against @p scene; @p as_initial: its fields and cells as
+ *  a new run's initial state at t = 0. The scene's text and overrides are
+ *  saved in the run's checkpoints (text NULL: none saved, and none can be
+ *  resumed). */
+typedef struct sp_checkpoint_s *sp_checkpoint_handle;
+typedef struct {
+  sp_checkpoint_handle checkpoint;
+  int as_initial;
+  const char *scene_text;
+  size_t scene_len;
+  int n_set;
+  const char *const *set;
+} sp_run_start;
+
+/** @brief sp_stepper_run_with, started as @p start says (NULL: the scene's
+ *         cells, no scene text saved). */
+int sp_stepper_run_from(const sp_scene *scene, const sp_run_start *start, const char *out_dir,
+                        MPI_Comm comm, sp_step_callback on_step, void *user,
+                        sp_run_summary *summary);
+
+/**
+ * @brief Ask the run in progress (this process's) to write a checkpoint at
+ *        the end of the step in progress and stop there (summary.stopped =
+ *        SP_STOPPED_SIGNAL). Async-signal-safe: `softpack run` calls it on
+ *        SIGTERM, SIGINT and SIGUSR1. One rank asking stops every rank.
+ */
+void sp_run_request_stop(void);
 
 #ifdef __cplusplus
 }

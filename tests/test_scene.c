@@ -334,8 +334,10 @@ static int load_dir(const char *relative) {
     snprintf(path, sizeof path, "%s/%s", dir_path, e->d_name);
     sp_scene *scene = NULL;
     int rc = sp_scene_load(path, 0, NULL, &scene);
-    CHECK(rc == SP_OK && scene && scene->n_cells >= 1, "%s: rc %d: %s", path, rc,
-          sp_error_message());
+    /* cells, or initial fields from a file */
+    CHECK(rc == SP_OK && scene &&
+              (scene->n_cells >= 1 || scene->initial.from[0] || scene->initial.label_image[0]),
+          "%s: rc %d: %s", path, rc, sp_error_message());
     if (rc == SP_OK) sp_scene_destroy(&scene);
     ++n;
   }

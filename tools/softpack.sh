@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(cmake make g++ pkg-config
   trilinos-all-dev trilinos-dev libsuperlu-dev libsuperlu-dist-dev
   libopenmpi-dev openmpi-bin libptscotch-dev libscotch-dev libopenblas-dev
-  libcyaml-dev libcairo2-dev)
+  libcyaml-dev libcairo2-dev libhdf5-openmpi-dev)
 
 # install_missing [EXTRA_PACKAGE...]: PACKAGES and the extras a command needs
 install_missing() {

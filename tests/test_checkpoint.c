@@ -1,0 +1,331 @@
+/* Checkpoints alone (src/checkpoint.c), no time stepping:
+ * - a round trip of the run state: a state with every member set (two
+ *   past states, a registry, the controller, the counters, the energy
+ *   history) is written, read back into another run and compared member by
+ *   member, bit for bit;
+ * - output.checkpoint_keep keeps the newest files only, and the newest
+ *   valid one is found past a damaged newer one;
+ * - a truncated file, a flipped byte, an HDF5 file that is not a
+ *   checkpoint and one of another format version are refused as bad input
+ *   (SP_ERR_INPUT) with a message saying which. */
+#include <hdf5.h>
+#include <hdf5_hl.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "checkpoint.h"
+#include "error.h"
+#include "run_state.h"
+
+#define DIR "checkpoint_test"
+
+static unsigned long long rng = 88172645463325252ULL;
+static double uniform(void) { /* xorshift64 */
+  rng ^= rng << 13;
+  rng ^= rng >> 7;
+  rng ^= rng << 17;
+  return (double)(rng >> 11) / 9007199254740992.0;
+}
+
+static double *random_array(size_t n) {
+  double *a = malloc(sizeof(double) * n + 1);
+  for (size_t i = 0; i < n; ++i) a[i] = uniform() - 0.25;
+  return a;
+}
+
+/** A run on @p mesh with three cells on random supports and every member
+ *  of the state set. */
+static void fill_run(sp_run *run, const sp_scene *scene, sp_mesh *mesh, sp_run_summary *sum) {
+  memset(run, 0, sizeof *run);
+  memset(sum, 0, sizeof *sum);
+  run->scene = scene;
+  run->mesh = mesh;
+  run->sum = sum;
+  run->n_ranks = 1;
+  static const char text[] = "a scene's text";
+  static const char *const set[] = {"time.t_end=1", "output.every=3"};
+  run->scene_text = text;
+  run->scene_len = strlen(text);
+  run->n_set = 2;
+  run->set = set;
+  const int nn = mesh->n_nodes, nc = 3;
+  unsigned char *mask = malloc((size_t)nn * nc);
+  for (size_t i = 0; i < (size_t)nn * nc; ++i) mask[i] = uniform() < 0.6;
+  CHECK_OK(sp_layout_create_from_masks(nn, nc, mask, &run->layout));
+  free(mask);
+  const size_t nv = 2 * (size_t)run->layout->n_pairs;
+  run->state = random_array(nv);
+  run->hist.n = 2;
+  run->hist.past[0] = random_array(nv);
+  run->hist.past[1] = random_array(nv);
+  run->hist.dt[0] = 1.5e-4;
+  run->hist.dt[1] = 1.25e-4;
+  run->step = 17;
+  run->t = 0.0123;
+  run->n_max = 9;
+  run->obs = calloc(nc, sizeof *run->obs);
+  run->birth = calloc(nc, sizeof *run->birth);
+  run->source_on = calloc(nc, sizeof(int));
+  run->division_skipped = calloc(nc, sizeof(int));
+  run->divided_now = calloc(nc, 1);
+  for (int k = 0; k < nc; ++k) {
+    run->birth[k] = (sp_cell_birth){.birth_time = uniform(), .birth_mass = uniform(),
+                                    .Iref = {uniform(), uniform()}, .generation = k + 1};
+    run->source_on[k] = k != 1;
+    run->division_skipped[k] = k == 2;
+    run->divided_now[k] = k == 0;
+  }
+  run->dtc = (sp_dt_control){.dt_next = uniform(), .failures = 2, .successes = 3,
+                             .ceiling = uniform(), .ceiling_steps = 4, .since_restart = 5,
+                             .err_prev = uniform(), .dt_last = uniform(), .rejected_last = 1,
+                             .n_accepted = 6, .n_rejected = 7, .n_newton_failed = 8};
+  *sum = (sp_run_summary){.steps = 17, .failed_attempts = 2, .newton_its = 40,
+                          .factorisations = 30, .failed_factorisations = 5, .linear_its = 9,
+                          .t_final = 0.0123, .dt_smallest = 1e-6, .wall_seconds = 3.5,
+                          .t_assembly = 1, .t_factor = 2, .t_solve = 0.5, .divisions = 2,
+                          .n_cells = 3, .layout_changes = 4, .support_mass_correction = 1e-3,
+                          .t_layout = 0.1, .support_mass_dropped = 1e-14,
+                          .support_energy_rise = 0.01, .unknowns_max = 1234,
+                          .checkpoints = 3, .t_checkpoints = 0.25};
+  run->n_energy = run->cap_energy = 5;
+  run->energy_t = random_array(5);
+  run->energy_total = random_array(5);
+  run->n_divisions = 2;
+  run->division_t = random_array(2);
+}
+
+static void free_run(sp_run *run) {
+  sp_layout_destroy(&run->layout);
+  free(run->state);
+  sp_history_free(&run->hist);
+  free(run->obs);
+  free(run->birth);
+  free(run->source_on);
+  free(run->division_skipped);
+  free(run->divided_now);
+  free(run->energy_t);
+  free(run->energy_total);
+  free(run->division_t);
+}
+
+/** The members in which two runs' states differ (printed if @p say). */
+static int differences(const sp_run *a, const sp_run *b, int say) {
+  int n = 0;
+#define DIFF(cond, what)                                                        \
+  do {                                                                         \
+    if (!(cond)) {                                                             \
+      ++n;                                                                     \
+      if (say) fprintf(stderr, "differs: %s\n", what);                         \
+    }                                                                          \
+  } while (0)
+  const sp_layout *la = a->layout, *lb = b->layout;
+  DIFF(la->n_nodes == lb->n_nodes && la->n_cells == lb->n_cells && la->n_pairs == lb->n_pairs,
+       "layout sizes");
+  if (n) return n;
+  DIFF(!memcmp(la->node_start, lb->node_start, sizeof(int) * (la->n_nodes + 1)), "node_start");
+  DIFF(!memcmp(la->pair_cell, lb->pair_cell, sizeof(int) * la->n_pairs), "pair_cell");
+  const size_t nv = 2 * (size_t)la->n_pairs;
+  DIFF(!memcmp(a->state, b->state, sizeof(double) * nv), "state");
+  DIFF(b->hist.n == a->hist.n && b->hist.dt[0] == a->hist.dt[0] &&
+       b->hist.dt[1] == a->hist.dt[1], "history n, dt");
+  for (int i = 0; i < a->hist.n && i < b->hist.n; ++i)
+    DIFF(!memcmp(a->hist.past[i], b->hist.past[i], sizeof(double) * nv), "history past");
+  DIFF(b->step == a->step && b->t == a->t && b->n_max == a->n_max, "step, t, n_max");
+  for (int k = 0; k < la->n_cells; ++k) {
+    DIFF(b->birth[k].birth_time == a->birth[k].birth_time &&
+         b->birth[k].birth_mass == a->birth[k].birth_mass &&
+         b->birth[k].Iref[0] == a->birth[k].Iref[0] && b->birth[k].Iref[1] == a->birth[k].Iref[1] &&
+         b->birth[k].generation == a->birth[k].generation, "birth");
+    DIFF(b->source_on[k] == a->source_on[k] && b->division_skipped[k] == a->division_skipped[k] &&
+         b->divided_now[k] == a->divided_now[k], "registry");
+  }
+  sp_dt_control da = a->dtc, db = b->dtc;
+  db.p = da.p; /* the parameters come from the scene */
+  DIFF(!memcmp(&da, &db, sizeof da), "the controller");
+  DIFF(!memcmp(a->sum, b->sum, sizeof *a->sum), "the summary");
+  DIFF(b->n_energy == a->n_energy && b->n_divisions == a->n_divisions, "energy history sizes");
+  if (b->n_energy == a->n_energy) {
+    DIFF(!memcmp(a->energy_t, b->energy_t, sizeof(double) * a->n_energy), "energy_t");
+    DIFF(!memcmp(a->energy_total, b->energy_total, sizeof(double) * a->n_energy), "energy_total");
+  }
+  if (b->n_divisions == a->n_divisions)
+    DIFF(!memcmp(a->division_t, b->division_t, sizeof(double) * a->n_divisions), "division_t");
+#undef DIFF
+  return n;
+}
+
+/** Open and restore @p path into @p run (zeroed first) on @p mesh. */
+static int restore(const char *path, const sp_scene *scene, sp_mesh *mesh, sp_run *run,
+                   sp_run_summary *sum) {
+  memset(run, 0, sizeof *run);
+  memset(sum, 0, sizeof *sum);
+  run->scene = scene;
+  run->mesh = mesh;
+  run->sum = sum;
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &run->layout));
+  sp_checkpoint ck;
+  int rc = sp_checkpoint_open(path, &ck);
+  if (rc != SP_OK) return rc;
+  sp_output_field *fields = NULL;
+  int n_fields = 0;
+  rc = sp_checkpoint_restore(ck, run, 0, &fields, &n_fields);
+  free(fields);
+  sp_checkpoint_close(&ck);
+  return rc;
+}
+
+static void round_trip(const sp_scene *scene, sp_mesh *mesh) {
+  sp_run a, b;
+  sp_run_summary sa, sb;
+  fill_run(&a, scene, mesh, &sa);
+  char path[4096];
+  CHECK_OK(sp_checkpoint_write(&a, DIR, path, sizeof path));
+  CHECK(strcmp(path, DIR "/checkpoint_000017.h5") == 0, "written to %s", path);
+  sp_checkpoint ck;
+  CHECK_OK(sp_checkpoint_open(path, &ck));
+  CHECK(sp_checkpoint_step(ck) == 17 && sp_checkpoint_time(ck) == 0.0123 &&
+            sp_checkpoint_mpi_size(ck) == 1, "step %d, t %g", sp_checkpoint_step(ck),
+        sp_checkpoint_time(ck));
+  size_t len;
+  int n_set;
+  const char *const *set;
+  const char *text = sp_checkpoint_scene(ck, &len, &n_set, &set);
+  CHECK(len == a.scene_len && memcmp(text, a.scene_text, len) == 0, "scene text");
+  CHECK(n_set == 2 && strcmp(set[0], a.set[0]) == 0 && strcmp(set[1], a.set[1]) == 0,
+        "overrides");
+  sp_checkpoint_close(&ck);
+  CHECK_OK(restore(path, scene, mesh, &b, &sb));
+  CHECK(differences(&a, &b, 1) == 0, "the state differs after the round trip");
+  /* keep 2: writing steps 18 and 19 leaves 18 and 19 */
+  a.step = 18;
+  CHECK_OK(sp_checkpoint_write(&a, DIR, NULL, 0));
+  a.step = 19;
+  CHECK_OK(sp_checkpoint_write(&a, DIR, NULL, 0));
+  CHECK(access(DIR "/checkpoint_000017.h5", F_OK) != 0, "checkpoint 17 kept (keep = 2)");
+  CHECK(access(DIR "/checkpoint_000018.h5", F_OK) == 0, "checkpoint 18 deleted");
+  char newest[4096];
+  CHECK_OK(sp_checkpoint_find_newest(DIR, newest, sizeof newest));
+  CHECK(strcmp(newest, DIR "/checkpoint_000019.h5") == 0, "newest: %s", newest);
+  CHECK(truncate(DIR "/checkpoint_000019.h5", 4000) == 0, "truncate");
+  CHECK_OK(sp_checkpoint_find_newest(DIR, newest, sizeof newest));
+  CHECK(strcmp(newest, DIR "/checkpoint_000018.h5") == 0, "newest past a damaged one: %s",
+        newest);
+  free_run(&a);
+  free_run(&b);
+}
+
+/** sp_checkpoint_open must refuse @p path as bad input with @p words in its message. */
+static void refused(const char *path, const char *words) {
+  sp_checkpoint ck = NULL;
+  const int rc = sp_checkpoint_open(path, &ck);
+  CHECK(rc == SP_ERR_INPUT && ck == NULL, "%s: rc %d", path, rc);
+  CHECK(strstr(sp_error_message(), words) != NULL, "%s: message '%s' lacks '%s'", path,
+        sp_error_message(), words);
+}
+
+static void copy_file(const char *from, const char *to) {
+  FILE *in = fopen(from, "rb"), *out = fopen(to, "wb");
+  char buf[65536];
+  for (size_t n; in && out && (n = fread(buf, 1, sizeof buf, in)) > 0;) fwrite(buf, 1, n, out);
+  if (in) fclose(in);
+  if (out) fclose(out);
+}
+
+static void bad_files(const sp_scene *scene, sp_mesh *mesh) {
+  const char *good = DIR "/checkpoint_000018.h5";
+  /* truncated */
+  copy_file(good, DIR "/truncated.h5");
+  struct stat st;
+  stat(good, &st);
+  CHECK(truncate(DIR "/truncated.h5", st.st_size / 2) == 0, "truncate");
+  refused(DIR "/truncated.h5", "damaged");
+  /* one byte flipped at 64 places: refused, or (a byte nothing reads)
+   * the same state restored */
+  sp_run g, r;
+  sp_run_summary sg, sr;
+  CHECK_OK(restore(good, scene, mesh, &g, &sg));
+  int n_refused = 0;
+  for (int where = 0; where < 64; ++where) {
+    copy_file(good, DIR "/flipped.h5");
+    FILE *f = fopen(DIR "/flipped.h5", "r+b");
+    const long at = (long)((st.st_size - 1) * (where + 0.5) / 64);
+    fseek(f, at, SEEK_SET);
+    const int c = fgetc(f);
+    fseek(f, at, SEEK_SET);
+    fputc(c ^ 0x5a, f);
+    fclose(f);
+    const int rc = restore(DIR "/flipped.h5", scene, mesh, &r, &sr);
+    CHECK(rc == SP_OK || rc == SP_ERR_INPUT, "byte %ld flipped: rc %d", at, rc);
+    if (rc == SP_OK)
+      CHECK(differences(&g, &r, 1) == 0, "byte %ld flipped: a different state was accepted", at);
+    n_refused += rc != SP_OK;
+    free_run(&r);
+  }
+  printf("a byte flipped at 64 places: %d refused, %d in bytes nothing reads\n", n_refused,
+         64 - n_refused);
+  free_run(&g);
+  /* a byte of each array's values flipped (a bit error in the data that
+   * HDF5's own structures would not notice): refused by its checksum */
+  static const char *const arrays[] = {"/state", "/history/past0", "/history/past1",
+                                       "/cells/birth_mass", "/layout/pair_cell", "/header_t"};
+  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) {
+    hid_t h = H5Fopen(good, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t d = H5Dopen2(h, arrays[i], H5P_DEFAULT);
+    const haddr_t offset = H5Dget_offset(d);
+    H5Dclose(d);
+    H5Fclose(h);
+    CHECK(offset != HADDR_UNDEF, "%s: no offset", arrays[i]);
+    copy_file(good, DIR "/flipped.h5");
+    FILE *f = fopen(DIR "/flipped.h5", "r+b");
+    fseek(f, (long)offset + 3, SEEK_SET);
+    const int c = fgetc(f);
+    fseek(f, (long)offset + 3, SEEK_SET);
+    fputc(c ^ 0x10, f);
+    fclose(f);
+    const int rc = restore(DIR "/flipped.h5", scene, mesh, &r, &sr);
+    CHECK(rc == SP_ERR_INPUT, "a byte of %s flipped: rc %d", arrays[i], rc);
+    CHECK(strstr(sp_error_message(), "checksum"), "a byte of %s flipped: '%s'", arrays[i],
+          sp_error_message());
+    free_run(&r);
+  }
+  /* not HDF5 */
+  FILE *f = fopen(DIR "/text.h5", "w");
+  fputs("not a checkpoint\n", f);
+  fclose(f);
+  refused(DIR "/text.h5", "not an HDF5 file");
+  /* HDF5, but not softpack's */
+  hid_t h = H5Fcreate(DIR "/foreign.h5", H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  const int one = 1;
+  H5LTset_attribute_int(h, "/", "format_version", &one, 1);
+  H5Fclose(h);
+  refused(DIR "/foreign.h5", "not a softpack checkpoint");
+  /* another format version */
+  copy_file(good, DIR "/version.h5");
+  h = H5Fopen(DIR "/version.h5", H5F_ACC_RDWR, H5P_DEFAULT);
+  const int v = SP_CHECKPOINT_VERSION + 1;
+  H5LTset_attribute_int(h, "/", "format_version", &v, 1);
+  H5Fclose(h);
+  refused(DIR "/version.h5", "format version");
+  refused(DIR "/missing.h5", "cannot read");
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  CHECK(system("rm -rf " DIR) == 0, "cannot clear " DIR);
+  mkdir(DIR, 0777);
+  static const char text[] = "mesh: {type: rectangle, nx: 8, ny: 6}\n"
+                             "output: {checkpoint_keep: 2}\n"
+                             "cells:\n  - {x: 0.5, y: 0.5, radius: 0.2}\n";
+  sp_scene *scene;
+  CHECK_OK(sp_scene_load_text("test", text, strlen(text), 0, NULL, &scene));
+  sp_mesh *mesh;
+  CHECK_OK(sp_mesh_from_scene(scene, &mesh));
+  round_trip(scene, mesh);
+  bad_files(scene, mesh);
+  sp_mesh_destroy(&mesh);
+  sp_scene_destroy(&scene);
+  MPI_Finalize();
+  TEST_DONE();
+}
