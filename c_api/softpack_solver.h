@@ -33,13 +33,15 @@ enum {
   SP_SOLVER_JAC_AD_DFAD = 3
 };
 /** Linear solver of each Newton iteration: direct, or GMRES preconditioned
- *  by ILU(k) (additive Schwarz, one ILU per rank, under MPI). */
+ *  by ILU(k) (additive Schwarz, one ILU per rank, under MPI). KLU2 is
+ *  Amesos2's (one process only), KLU Amesos (v1)'s. */
 enum {
   SP_SOLVER_SUPERLU = 0,
   SP_SOLVER_SUPERLU_DIST = 1,
   SP_SOLVER_MUMPS = 2,
   SP_SOLVER_KLU2 = 3,
-  SP_SOLVER_GMRES_ILU = 4
+  SP_SOLVER_GMRES_ILU = 4,
+  SP_SOLVER_KLU = 5
 };
 /** SuperLU_DIST's fill-reducing column order: METIS on the graph of the
  *  (cell, node) pairs (c and mu of a pair together), or on the unknowns

@@ -58,9 +58,13 @@ int sp_solver_linear_backend(int linear, const char **backend) {
         what = sp::amesos_version("Amesos_Mumps");
         available = sp::amesos_available("Amesos_Mumps");
         break;
-      case SP_SOLVER_KLU2:
+      case SP_SOLVER_KLU:
         what = sp::amesos_version("Amesos_Klu");
         available = sp::amesos_available("Amesos_Klu");
+        break;
+      case SP_SOLVER_KLU2:
+        what = sp::amesos2_klu2_version();
+        available = sp::amesos2_klu2_available();
         break;
       case SP_SOLVER_GMRES_ILU: what = sp::krylov_version(); break;
       default: return -1;

@@ -228,14 +228,15 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
                                   options.refine != 0);
       break;
     case SP_SOLVER_MUMPS: direct_ = make_amesos(comm, "Amesos_Mumps"); break;
+    case SP_SOLVER_KLU: direct_ = make_amesos(comm, "Amesos_Klu"); break;
     case SP_SOLVER_KLU2:
       // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
-      // ranks (docs/parallel.md): KLU runs on one process only.
+      // ranks (STACK.md, docs/parallel.md): one process only.
       if (P > 1)
         throw std::runtime_error("solver.linear: klu2 runs on one MPI process only (this run has " +
                                  std::to_string(P) +
-                                 "); use superlu_dist or mumps with several processes");
-      direct_ = make_amesos(comm, "Amesos_Klu");
+                                 "); use superlu_dist, mumps or klu with several processes");
+      direct_ = make_amesos2_klu2(comm);
       break;
     case SP_SOLVER_GMRES_ILU: {
       // taken as given: 0 is ILU(0), not a default (the scene has those)

@@ -13,7 +13,7 @@
  *   mpi_compare iterates LINEAR...
  *     The first Newton iterates of one step (three touching cells, 40 x 40
  *     rectangle) with each backend LINEAR (superlu, superlu_dist, mumps,
- *     klu2) on MPI_COMM_WORLD against serial SuperLU on MPI_COMM_SELF:
+ *     klu, klu2) on MPI_COMM_WORLD against serial SuperLU on MPI_COMM_SELF:
  *     max |x_k - x_k,ref| <= 1e-10 max |x_k,ref| for k = 1..4.
  *
  *   mpi_compare cli            (run without mpirun)
@@ -230,6 +230,7 @@ static int linear_kind(const char *name) {
   if (strcmp(name, "superlu_dist") == 0) return SP_SOLVER_SUPERLU_DIST;
   if (strcmp(name, "mumps") == 0) return SP_SOLVER_MUMPS;
   if (strcmp(name, "klu2") == 0) return SP_SOLVER_KLU2;
+  if (strcmp(name, "klu") == 0) return SP_SOLVER_KLU;
   return -1;
 }
 
