@@ -196,6 +196,17 @@ int sp_solver_residual(sp_solver s, const sp_step_data *data,
                        const double *state, double *residual);
 
 /**
+ * @brief The Jacobian of the step equations at @p state, as Newton uses it
+ *        (the solver's Jacobian kind; with an implicit shape term, its
+ *        low-rank part included), applied to @p x: y = J x, or y = J^T x if
+ *        @p transpose is non-zero; a test hook. x and y: layout order,
+ *        length 2 n_pairs. Collective.
+ */
+int sp_solver_apply_jacobian(sp_solver s, const sp_step_data *data,
+                             const double *state, int transpose,
+                             const double *x, double *y);
+
+/**
  * @brief Compare the element Jacobian of kind @p jacobian with a central
  *        finite-difference one at @p state: largest |J - J_fd| / max|J_fd|
  *        over all elements.

@@ -130,6 +130,15 @@ int sp_solver_residual(sp_solver s, const sp_step_data *data, const double *stat
   });
 }
 
+int sp_solver_apply_jacobian(sp_solver s, const sp_step_data *data, const double *state,
+                             int transpose, const double *x, double *y) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl && data && state && x && y, "sp_solver_apply_jacobian: null argument");
+    s->impl->jacobian_times(*data, state, transpose != 0, x, y);
+  });
+}
+
 int sp_solver_check_jacobian(sp_solver s, const sp_step_data *data, const double *state,
                              int jacobian, double *max_rel_err) {
   if (!s) return SP_API_ERR + 1;
