@@ -66,20 +66,17 @@ void LowRankTerm::v_dots(MPI_Comm comm, const double *x, std::vector<double> &t)
   dots(comm, m, v_ptr, v_col, v_val, x, t);
 }
 
-void LowRankTerm::add_apply(MPI_Comm comm, const double *x, double *y) const {
+void LowRankTerm::add_apply(MPI_Comm comm, const double *x, double *y, bool transpose) const {
   if (empty()) return;
+  // U C V^T x, or its transpose V C^T U^T x: the roles of U and V swap
+  const auto &in_ptr = transpose ? u_ptr : v_ptr, &in_col = transpose ? u_col : v_col;
+  const auto &in_val = transpose ? u_val : v_val;
+  const auto &out_ptr = transpose ? v_ptr : u_ptr, &out_col = transpose ? v_col : u_col;
+  const auto &out_val = transpose ? v_val : u_val;
   std::vector<double> t, w;
-  dots(comm, m, v_ptr, v_col, v_val, x, t);
-  times_c(c, m, t, w, false);
-  add_times(u_ptr, u_col, u_val, w, y);
-}
-
-void LowRankTerm::add_apply_transpose(MPI_Comm comm, const double *x, double *y) const {
-  if (empty()) return;
-  std::vector<double> t, w;
-  dots(comm, m, u_ptr, u_col, u_val, x, t);
-  times_c(c, m, t, w, true);
-  add_times(v_ptr, v_col, v_val, w, y);
+  dots(comm, m, in_ptr, in_col, in_val, x, t);
+  times_c(c, m, t, w, transpose);
+  add_times(out_ptr, out_col, out_val, w, y);
 }
 
 LowRankSolver::LowRankSolver(MPI_Comm comm, std::unique_ptr<DirectSolver> sparse)

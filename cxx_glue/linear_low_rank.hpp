@@ -28,10 +28,8 @@ struct LowRankTerm {
   bool empty() const { return m == 0; }
   // t = V^T x (length m, reduced over comm); x is this rank's rows.
   void v_dots(MPI_Comm comm, const double *x, std::vector<double> &t) const;
-  // y += U C V^T x (collective).
-  void add_apply(MPI_Comm comm, const double *x, double *y) const;
-  // y += V C^T U^T x (collective): the transpose of add_apply.
-  void add_apply_transpose(MPI_Comm comm, const double *x, double *y) const;
+  // y += U C V^T x, or with transpose y += V C^T U^T x (collective).
+  void add_apply(MPI_Comm comm, const double *x, double *y, bool transpose) const;
 };
 
 // Every rank learns whether all ranks succeeded and, if not, the message of

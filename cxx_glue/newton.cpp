@@ -348,11 +348,7 @@ bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out, bool tr
   const bool ok = jacobian_matrix->Apply(in, out) == 0;
   jacobian_matrix->SetUseTranspose(false);
   if (!ok) return false;
-  const LowRankTerm &term = linear_->term();
-  if (transpose)
-    term.add_apply_transpose(comm_.Comm(), in.Values(), out.Values());
-  else
-    term.add_apply(comm_.Comm(), in.Values(), out.Values());
+  linear_->term().add_apply(comm_.Comm(), in.Values(), out.Values(), transpose);
   return true;
 }
 
