@@ -33,13 +33,15 @@ enum {
   SP_SOLVER_JAC_AD_DFAD = 3
 };
 /** Linear solver of each Newton iteration: direct, or GMRES preconditioned
- *  by ILU(k) (additive Schwarz, one ILU per rank, under MPI). */
+ *  by ILU(k) (additive Schwarz, one ILU per rank, under MPI). KLU2 is
+ *  Amesos2's (one process only), KLU Amesos (v1)'s. */
 enum {
   SP_SOLVER_SUPERLU = 0,
   SP_SOLVER_SUPERLU_DIST = 1,
   SP_SOLVER_MUMPS = 2,
   SP_SOLVER_KLU2 = 3,
-  SP_SOLVER_GMRES_ILU = 4
+  SP_SOLVER_GMRES_ILU = 4,
+  SP_SOLVER_KLU = 5
 };
 /** SuperLU_DIST's fill-reducing column order: METIS on the graph of the
  *  (cell, node) pairs (c and mu of a pair together), or on the unknowns
@@ -198,6 +200,17 @@ int sp_solver_energy(sp_solver s, const sp_model_params *model,
  */
 int sp_solver_residual(sp_solver s, const sp_step_data *data,
                        const double *state, double *residual);
+
+/**
+ * @brief The Jacobian of the step equations at @p state, as Newton uses it
+ *        (the solver's Jacobian kind; with an implicit shape term, its
+ *        low-rank part included), applied to @p x: y = J x, or y = J^T x if
+ *        @p transpose is non-zero; a test hook. x and y: layout order,
+ *        length 2 n_pairs. Collective.
+ */
+int sp_solver_apply_jacobian(sp_solver s, const sp_step_data *data,
+                             const double *state, int transpose,
+                             const double *x, double *y);
 
 /**
  * @brief Compare the element Jacobian of kind @p jacobian with a central

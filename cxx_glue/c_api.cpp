@@ -58,9 +58,13 @@ int sp_solver_linear_backend(int linear, const char **backend) {
         what = sp::amesos_version("Amesos_Mumps");
         available = sp::amesos_available("Amesos_Mumps");
         break;
-      case SP_SOLVER_KLU2:
+      case SP_SOLVER_KLU:
         what = sp::amesos_version("Amesos_Klu");
         available = sp::amesos_available("Amesos_Klu");
+        break;
+      case SP_SOLVER_KLU2:
+        what = sp::amesos2_klu2_version();
+        available = sp::amesos2_klu2_available();
         break;
       case SP_SOLVER_GMRES_ILU: what = sp::krylov_version(); break;
       default: return -1;
@@ -131,6 +135,15 @@ int sp_solver_residual(sp_solver s, const sp_step_data *data, const double *stat
   return guarded(s, [&] {
     need(s->impl && data && state && residual, "sp_solver_residual: null argument");
     s->impl->residual(*data, state, residual);
+  });
+}
+
+int sp_solver_apply_jacobian(sp_solver s, const sp_step_data *data, const double *state,
+                             int transpose, const double *x, double *y) {
+  if (!s) return SP_API_ERR + 1;
+  return guarded(s, [&] {
+    need(s->impl && data && state && x && y, "sp_solver_apply_jacobian: null argument");
+    s->impl->jacobian_times(*data, state, transpose != 0, x, y);
   });
 }
 

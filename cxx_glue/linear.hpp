@@ -71,6 +71,9 @@ std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, 
 // Amesos (v1) on an Epetra copy of the rows: which = "Amesos_Mumps" or
 // "Amesos_Klu". Throws if Amesos was built without it.
 std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &which);
+// KLU2 through Amesos2 on an Epetra copy of the rows; one process only
+// (throws on several: Debian 13.2's Amesos2 is wrong there, STACK.md).
+std::unique_ptr<DirectSolver> make_amesos2_klu2(MPI_Comm comm);
 // GMRES preconditioned by ILU(fill) (additive Schwarz across ranks), to a
 // residual of tolerance x |b|. fill and tolerance come from the caller
 // (the scene's solver.ilu_fill and solver.krylov_tol hold the defaults).
@@ -92,6 +95,8 @@ const char *superlu_dist_version();
 const char *amesos_version(const std::string &which);
 // Whether this Trilinos' Amesos was built with "Amesos_Mumps", "Amesos_Klu".
 bool amesos_available(const std::string &which);
+const char *amesos2_klu2_version();
+bool amesos2_klu2_available();
 const char *krylov_version();
 
 }  // namespace sp

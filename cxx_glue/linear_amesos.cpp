@@ -123,7 +123,7 @@ bool amesos_available(const std::string &which) { return Amesos().Query(which); 
 
 const char *amesos_version(const std::string &which) {
   if (which == "Amesos_Mumps") return "MUMPS " MUMPS_VERSION " through Amesos";
-  if (which == "Amesos_Klu") return "Amesos' own KLU (one process only)";
+  if (which == "Amesos_Klu") return "Amesos' own KLU (gathered on rank 0 under MPI)";
   return "unknown";
 }
 

@@ -56,14 +56,11 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
  public:
   DirectLinearSystem(Solver &s, StepInterface &i) : s_(s), i_(i) {}
   bool applyJacobian(const NOX::Epetra::Vector &in, NOX::Epetra::Vector &out) const override {
-    return s_.apply_jacobian(in.getEpetraVector(), out.getEpetraVector());
+    return s_.apply_jacobian(in.getEpetraVector(), out.getEpetraVector(), false);
   }
   bool applyJacobianTranspose(const NOX::Epetra::Vector &in,
                               NOX::Epetra::Vector &out) const override {
-    s_.jacobian_matrix->SetUseTranspose(true);
-    bool ok = s_.jacobian_matrix->Apply(in.getEpetraVector(), out.getEpetraVector()) == 0;
-    s_.jacobian_matrix->SetUseTranspose(false);
-    return ok;
+    return s_.apply_jacobian(in.getEpetraVector(), out.getEpetraVector(), true);
   }
   bool applyJacobianInverse(Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
                             NOX::Epetra::Vector &out) override {
@@ -217,25 +214,27 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
   if (!(options.newton_divergence == 0 || options.newton_divergence > 1))
     throw std::runtime_error("solver.newton_divergence: expected 0 (off) or a value > 1");
   const int P = comm_.NumProc();
+  std::unique_ptr<DirectSolver> direct;
   switch (options.linear) {
     case SP_SOLVER_SUPERLU:
       // Serial SuperLU under MPI: the matrix is gathered on rank 0.
-      direct_ = P == 1 ? make_superlu()
+      direct = P == 1 ? make_superlu()
                        : make_gathered(comm, comm_.MyPID() == 0 ? make_superlu() : nullptr);
       break;
     case SP_SOLVER_SUPERLU_DIST:
-      direct_ = make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS,
+      direct = make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS,
                                   options.refine != 0);
       break;
-    case SP_SOLVER_MUMPS: direct_ = make_amesos(comm, "Amesos_Mumps"); break;
+    case SP_SOLVER_MUMPS: direct = make_amesos(comm, "Amesos_Mumps"); break;
+    case SP_SOLVER_KLU: direct = make_amesos(comm, "Amesos_Klu"); break;
     case SP_SOLVER_KLU2:
       // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
-      // ranks (docs/parallel.md): KLU runs on one process only.
+      // ranks (STACK.md, docs/parallel.md): one process only.
       if (P > 1)
         throw std::runtime_error("solver.linear: klu2 runs on one MPI process only (this run has " +
                                  std::to_string(P) +
-                                 "); use superlu_dist or mumps with several processes");
-      direct_ = make_amesos(comm, "Amesos_Klu");
+                                 "); use superlu_dist, mumps or klu with several processes");
+      direct = make_amesos2_klu2(comm);
       break;
     case SP_SOLVER_GMRES_ILU: {
       // taken as given: 0 is ILU(0), not a default (the scene has those)
@@ -249,11 +248,12 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
             std::string("solver.ilu_fill / krylov_tol: expected fill >= 0 and 0 < tol < 1, got ") +
             got);
       }
-      direct_ = make_krylov(comm, k);
+      direct = make_krylov(comm, k);
       break;
     }
     default: throw std::runtime_error("solver.linear: unknown kind");
   }
+  linear_ = std::make_unique<LowRankSolver>(comm, std::move(direct));
 }
 
 void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout) {
@@ -320,226 +320,54 @@ void Solver::gather(const Epetra_Vector &x, std::vector<double> &full) const {
                  MPI_DOUBLE, comm_.Comm());
 }
 
-namespace {
-bool agree(MPI_Comm comm, bool ok, std::string &why);
-}  // namespace
-
 void Solver::fill_residual(const sp_step_data &d, const Epetra_Vector &x, Epetra_Vector &F) {
   double t0 = now();
   gather(x, full_);
-  assembly_->residual(data_at(d, full_.data()), full_.data(), F);
+  assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), F);
   t_assembly += now() - t0;
 }
 
 void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
   double t0 = now();
   gather(x, full_);
-  // The element Jacobians take the coefficients as constants; their
-  // dependence on the moments is the low-rank part (factor_low_rank).
-  assembly_->jacobian(data_at(d, full_.data()), full_.data(), options_.jacobian,
-                      *jacobian_matrix);
+  // The element Jacobians take the shape coefficients as constants; their
+  // dependence on the moments is the low-rank part (prepare_shape).
+  assembly_->jacobian(shape_.data_at(d, *assembly_, full_.data()), full_.data(),
+                      options_.jacobian, *jacobian_matrix);
   jacobian_fresh_ = true;
   t_assembly += now() - t0;
 }
 
 void Solver::prepare_shape(const sp_step_data &d) {
-  shape_u_.clear();
-  shape_coef_.clear();
-  active_of_cell_.clear();
-  low_rank_c_.clear();
-  row_active_.clear();
-  woodbury_lu_.clear();
-  woodbury_z_.clear();
-  if (!d.shape || !d.shape_implicit) return;
-  const int n_cells = assembly_->n_cells();
-  active_of_cell_.assign(n_cells, -1);
-  int n_active = 0;
-  for (int k = 0; k < n_cells; ++k) {
-    const sp_shape_coef &sc = d.shape[k];
-    bool any = false;
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2; ++j) {
-        if (!std::isfinite(sc.gain[i][j]))
-          throw std::runtime_error("shape: gain of cell " + std::to_string(k) + " is not finite");
-        any = any || sc.gain[i][j] != 0.0;
-      }
-    if (!any) continue;
-    active_of_cell_[k] = n_active++;
-    for (int i = 0; i < 2; ++i)
-      for (int j = 0; j < 2; ++j) low_rank_c_.push_back(-sc.gain[i][j]);
-  }
-  shape_coef_.assign(d.shape, d.shape + n_cells);
-  shape_data_ = d;
-  shape_data_.shape = shape_coef_.data();
-  if (n_active == 0) return;
-  assembly_->shape_weights(d, shape_u_);
-  const Epetra_Map &map = assembly_->map();
-  row_active_.assign(map.NumMyElements(), -1);
-  for (int r = 0; r < map.NumMyElements(); ++r)
-    row_active_[r] = active_of_cell_[assembly_->pair_cell(map.GID(r) / 2)];
+  shape_.prepare(d, *assembly_);
+  linear_->set_term(shape_.jacobian_term(*assembly_));
 }
 
-const sp_step_data &Solver::data_at(const sp_step_data &d, const double *state) {
-  if (shape_coef_.empty()) return d;
-  // dI_j = int_mask Ihat_j (c - c^n) per cell, from the replicated state.
-  const int n_cells = (int)shape_coef_.size();
-  std::vector<double> dI(2 * (size_t)n_cells, 0.0);
-  if (!shape_u_.empty())
-    for (int p = 0; p < assembly_->n_dofs() / 2; ++p) {
-      const int k = assembly_->pair_cell(p);
-      if (active_of_cell_[k] < 0) continue;
-      const double dc = state[2 * p] - d.state_old[2 * p];
-      dI[2 * k] += shape_u_[2 * p] * dc;
-      dI[2 * k + 1] += shape_u_[2 * p + 1] * dc;
-    }
-  for (int k = 0; k < n_cells; ++k)
-    for (int i = 0; i < 2; ++i)
-      shape_coef_[k].coef[i] = d.shape[k].coef[i] - d.shape[k].gain[i][0] * dI[2 * k] -
-                               d.shape[k].gain[i][1] * dI[2 * k + 1];
-  return shape_data_;
-}
-
-void Solver::low_rank_dots(const double *x, int f, std::vector<double> &t) const {
-  const Epetra_Map &map = assembly_->map();
-  std::vector<double> mine(low_rank_c_.size() / 2, 0.0);
-  for (int r = 0; r < (int)row_active_.size(); ++r) {
-    const int a = row_active_[r], g = map.GID(r);
-    if (a < 0 || g % 2 != f) continue;
-    mine[2 * a] += shape_u_[g - f] * x[r];
-    mine[2 * a + 1] += shape_u_[g - f + 1] * x[r];
-  }
-  t.resize(mine.size());
-  MPI_Allreduce(mine.data(), t.data(), (int)mine.size(), MPI_DOUBLE, MPI_SUM, comm_.Comm());
-}
-
-void Solver::low_rank_add(const std::vector<double> &w, int f, double *x) const {
-  const Epetra_Map &map = assembly_->map();
-  for (int r = 0; r < (int)row_active_.size(); ++r) {
-    const int a = row_active_[r], g = map.GID(r);
-    if (a < 0 || g % 2 != f) continue;
-    x[r] += shape_u_[g - f] * w[2 * a] + shape_u_[g - f + 1] * w[2 * a + 1];
-  }
-}
-
-namespace {
-
-// C t per active cell: (C t)[2a + i] = sum_j C_a[i][j] t[2a + j], C_a = -gain.
-std::vector<double> times_c(const std::vector<double> &c, const std::vector<double> &t) {
-  std::vector<double> out(t.size());
-  for (size_t a = 0; 2 * a < t.size(); ++a)
-    for (int i = 0; i < 2; ++i)
-      out[2 * a + i] = c[4 * a + 2 * i] * t[2 * a] + c[4 * a + 2 * i + 1] * t[2 * a + 1];
-  return out;
-}
-
-}  // namespace
-
-// The Jacobian is A + U C V^T: A the sparse (element) part, U's columns the
-// shape weights u_i of an active cell on its mu rows, V's the same on its c
-// rows, C = -gain per cell (R_mu holds +coef_i u_i, and coef_i falls by
-// gain[i][j] dI_j). Woodbury: x = y - Z w with y = A^-1 b, Z = A^-1 U and
-// (I + C V^T Z) w = C V^T y. After each factorisation, b and the 2 columns
-// of U per active cell are solved as one block (y and Z: counted in
-// t_solve), and K = I + C V^T Z is LU-factored here, identically on every
-// rank; Z is kept for further solves with the same factorisation.
-bool Solver::factor_low_rank(const double *b, double *y, std::string &why) {
-  const int m = (int)low_rank_c_.size() / 2;
-  const int n = (int)row_active_.size();
-  std::vector<double> B((size_t)n * (m + 1), 0.0), X((size_t)n * (m + 1)), col(m, 0.0), t;
-  std::copy(b, b + n, B.begin());
-  for (int c = 0; c < m; ++c) {
-    col[c] = 1.0;
-    low_rank_add(col, 1, B.data() + (size_t)(c + 1) * n);
-    col[c] = 0.0;
-  }
-  bool ok = direct_->solve_many(B.data(), X.data(), m + 1, n, why);
-  if (!agree(comm_.Comm(), ok, why)) return false;
-  std::copy(X.begin(), X.begin() + n, y);
-  woodbury_z_.assign(X.begin() + n, X.end());
-  // S = V^T Z, then K = I + C S, row r = 2a + i: sum_j C_a[i][j] S[2a + j][.]
-  std::vector<double> S((size_t)m * m);
-  for (int c = 0; c < m; ++c) {
-    low_rank_dots(woodbury_z_.data() + (size_t)c * n, 0, t);
-    for (int r = 0; r < m; ++r) S[(size_t)r * m + c] = t[r];
-  }
-  woodbury_lu_.assign((size_t)m * m, 0.0);
-  for (int r = 0; r < m; ++r) {
-    const int a = r / 2, i = r % 2;
-    for (int c = 0; c < m; ++c)
-      woodbury_lu_[(size_t)r * m + c] = (r == c ? 1.0 : 0.0) +
-                                        low_rank_c_[4 * a + 2 * i] * S[(size_t)(2 * a) * m + c] +
-                                        low_rank_c_[4 * a + 2 * i + 1] * S[(size_t)(2 * a + 1) * m + c];
-  }
-  // LU with partial pivoting (small and dense: 2 per active cell).
-  woodbury_piv_.assign(m, 0);
-  double *K = woodbury_lu_.data();
-  for (int k = 0; k < m; ++k) {
-    int p = k;
-    for (int r = k + 1; r < m; ++r)
-      if (std::fabs(K[(size_t)r * m + k]) > std::fabs(K[(size_t)p * m + k])) p = r;
-    woodbury_piv_[k] = p;
-    if (!(std::fabs(K[(size_t)p * m + k]) > 0) || !std::isfinite(K[(size_t)p * m + k])) {
-      why = "shape term: the Woodbury matrix is singular";
-      return false;
-    }
-    if (p != k)
-      for (int c = 0; c < m; ++c) std::swap(K[(size_t)k * m + c], K[(size_t)p * m + c]);
-    for (int r = k + 1; r < m; ++r) {
-      const double l = K[(size_t)r * m + k] /= K[(size_t)k * m + k];
-      for (int c = k + 1; c < m; ++c) K[(size_t)r * m + c] -= l * K[(size_t)k * m + c];
-    }
-  }
+bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out, bool transpose) {
+  jacobian_matrix->SetUseTranspose(transpose);
+  const bool ok = jacobian_matrix->Apply(in, out) == 0;
+  jacobian_matrix->SetUseTranspose(false);
+  if (!ok) return false;
+  linear_->term().add_apply(comm_.Comm(), in.Values(), out.Values(), transpose);
   return true;
 }
 
-void Solver::woodbury_correct(double *x) const {
-  std::vector<double> t;
-  low_rank_dots(x, 0, t);
-  std::vector<double> w = times_c(low_rank_c_, t);  // C V^T y
-  const int m = (int)w.size(), n = (int)row_active_.size();
-  const double *K = woodbury_lu_.data();
-  for (int k = 0; k < m; ++k) std::swap(w[k], w[woodbury_piv_[k]]);
-  for (int r = 0; r < m; ++r)
-    for (int c = 0; c < r; ++c) w[r] -= K[(size_t)r * m + c] * w[c];
-  for (int r = m - 1; r >= 0; --r) {
-    for (int c = r + 1; c < m; ++c) w[r] -= K[(size_t)r * m + c] * w[c];
-    w[r] /= K[(size_t)r * m + r];
+void Solver::jacobian_times(const sp_step_data &d, const double *state, bool transpose,
+                            const double *x, double *y) {
+  require_problem();
+  const Epetra_Map &map = assembly_->map();
+  Epetra_Vector at(map), in(map), out(map);
+  for (int i = 0; i < map.NumMyElements(); ++i) {
+    at[i] = state[map.GID(i)];
+    in[i] = x[map.GID(i)];
   }
-  for (int c = 0; c < m; ++c)
-    for (int i = 0; i < n; ++i) x[i] -= woodbury_z_[(size_t)c * n + i] * w[c];
+  prepare_shape(d);
+  fill_jacobian(d, at);
+  if (!apply_jacobian(in, out, transpose)) throw std::runtime_error("Jacobian: Apply failed");
+  std::vector<double> full;
+  gather(out, full);
+  std::copy(full.begin(), full.end(), y);
 }
-
-bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out) {
-  if (jacobian_matrix->Apply(in, out) != 0) return false;
-  if (shape_u_.empty()) return true;
-  std::vector<double> t;
-  low_rank_dots(in.Values(), 0, t);
-  low_rank_add(times_c(low_rank_c_, t), 1, out.Values());
-  return true;
-}
-
-namespace {
-
-// Every rank learns whether all ranks succeeded and, if not, the message of
-// the lowest failing rank (NOX must take the same path on every rank).
-bool agree(MPI_Comm comm, bool ok, std::string &why) {
-  int rank, size;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
-  int mine = ok ? size : rank, first = size;
-  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
-  if (first == size) return true;
-  int len = rank == first ? (int)why.size() : 0;
-  MPI_Bcast(&len, 1, MPI_INT, first, comm);
-  std::string msg(len, ' ');
-  if (rank == first) msg = why;
-  MPI_Bcast(&msg[0], len, MPI_CHAR, first, comm);
-  why = msg.empty() ? "the linear solver failed" : msg;
-  if (size > 1 && first > 0) why += " (rank " + std::to_string(first) + ")";
-  return false;
-}
-
-}  // namespace
 
 bool Solver::may_reuse_jacobian() const {
   const size_t n = step_norms_.size();
@@ -550,8 +378,8 @@ bool Solver::may_reuse_jacobian() const {
 }
 
 bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
-  const bool low_rank = !shape_u_.empty();
-  if (jacobian_fresh_) {
+  const bool fresh = jacobian_fresh_;
+  if (fresh) {
     double t0 = now();
     const int n = (int)csr_ptr_.size() - 1;
     for (int i = 0; i < n; ++i) {
@@ -567,9 +395,9 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
     A.row_ptr = csr_ptr_.data();
     A.col = csr_col_.data();
     A.val = csr_val_.data();
-    direct_->set_rhs_count(low_rank ? (int)low_rank_c_.size() / 2 + 1 : 1);
-    bool ok = direct_->factor(A, !pattern_changed_, why);
-    ok = agree(comm_.Comm(), ok, why);
+    linear_->set_rhs_count(1);
+    bool ok = linear_->factor(A, !pattern_changed_, why);
+    ok = all_agree(comm_.Comm(), ok, why);
     t_factor += now() - t0;
     if (!ok) {
       pattern_changed_ = true;  // start the next factorisation from scratch
@@ -578,20 +406,13 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
     pattern_changed_ = false;
     jacobian_fresh_ = false;
     ++step_factorisations_;
-    if (low_rank) {
-      t0 = now();
-      ok = factor_low_rank(b.Values(), x.Values(), why);
-      if (ok) woodbury_correct(x.Values());
-      t_solve += now() - t0;
-      if (!ok) jacobian_fresh_ = true;  // K is stale: refactor before the next solve
-      return ok;
-    }
   }
+  // (the first solve after a factorisation also does the low-rank term's
+  // block solve and small factorisation: counted as solve time)
   double t0 = now();
-  bool ok = direct_->solve(b.Values(), x.Values(), why);
-  ok = agree(comm_.Comm(), ok, why);
-  if (ok && low_rank) woodbury_correct(x.Values());
+  bool ok = linear_->solve(b.Values(), x.Values(), why);
   t_solve += now() - t0;
+  if (!ok && fresh) jacobian_fresh_ = true;  // refactor before the next solve
   return ok;
 }
 
@@ -602,7 +423,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   step_factorisations_ = 0;
   step_norms_.clear();
   const double t_start = now();
-  const long linear_its_before = direct_->iterations();
+  const long linear_its_before = linear_->iterations();
   const Epetra_Map &map = assembly_->map();
   Epetra_Vector x0(map);
   for (int i = 0; i < map.NumMyElements(); ++i) x0[i] = state[map.GID(i)];
@@ -680,7 +501,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   }
   report.newton_its = solver->getNumIterations();
   report.factorisations = step_factorisations_;
-  report.linear_its = direct_->iterations() - linear_its_before;
+  report.linear_its = linear_->iterations() - linear_its_before;
   report.n_residuals = (int)std::min<size_t>(step_norms_.size(), SP_MAX_NEWTON_HISTORY);
   std::copy(step_norms_.begin(), step_norms_.begin() + report.n_residuals, report.residual_norms);
   report.t_assembly = t_assembly;
@@ -724,8 +545,8 @@ sp_energy_parts Solver::energy(const sp_model_params &m, const double *state) co
 void Solver::residual(const sp_step_data &d, const double *state, double *out) {
   require_problem();
   Epetra_Vector F(assembly_->map());
-  prepare_shape(d);
-  assembly_->residual(data_at(d, state), state, F);
+  shape_.prepare(d, *assembly_);
+  assembly_->residual(shape_.data_at(d, *assembly_, state), state, F);
   std::vector<double> full;
   gather(F, full);
   std::copy(full.begin(), full.end(), out);

@@ -1,6 +1,7 @@
 // The object behind the sp_solver handle: an Assembly for the current
-// layout, the Jacobian matrix, a direct solver, and one NOX Newton solve per
-// backward-Euler step.
+// layout, the Jacobian (a sparse matrix and, with the implicit shape term,
+// a low-rank part beside it), a linear solver for it, and one NOX Newton
+// solve per backward-Euler step.
 #ifndef SP_NEWTON_HPP
 #define SP_NEWTON_HPP
 
@@ -14,6 +15,8 @@
 
 #include "assembly.hpp"
 #include "linear.hpp"
+#include "linear_low_rank.hpp"
+#include "shape_implicit.hpp"
 #include "softpack_solver.h"
 
 namespace sp {
@@ -43,8 +46,13 @@ class Solver {
   void fill_residual(const sp_step_data &data, const Epetra_Vector &x, Epetra_Vector &F);
   void fill_jacobian(const sp_step_data &data, const Epetra_Vector &x);
   bool solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why);
-  // out = J in, J with the implicit shape term's low-rank part.
-  bool apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out);
+  // out = J in (or J^T in), J the sparse matrix plus the implicit shape
+  // term's low-rank part.
+  bool apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out, bool transpose);
+  // The Jacobian of the step equations at state applied to x (or its
+  // transpose): a test hook (sp_solver_apply_jacobian); full vectors.
+  void jacobian_times(const sp_step_data &data, const double *state, bool transpose,
+                      const double *x, double *y);
   // ||F|| after each iteration of the current step (and at its guess).
   void note_residual(double norm) { step_norms_.push_back(norm); }
   // Modified Newton (sp_solver_options.jacobian_reuse): whether the next
@@ -60,27 +68,17 @@ class Solver {
 
  private:
   void require_problem() const;
-  // The implicit shape term (softpack_solver.h, sp_shape_coef): its weights
-  // for a step, the step data with the coefficients at a state, and the
-  // Woodbury factor of its low-rank Jacobian part.
+  // A step's implicit shape term: its coefficients (shape_) and its
+  // Jacobian part, handed to the linear solver.
   void prepare_shape(const sp_step_data &data);
-  const sp_step_data &data_at(const sp_step_data &data, const double *state);
-  // After a factorisation: y = A^-1 b and Z = A^-1 U in one block solve,
-  // and the LU of K; woodbury_correct turns y into the solution.
-  bool factor_low_rank(const double *b, double *y, std::string &why);
-  void woodbury_correct(double *y) const;
-  // t[2a + j] = sum over this rank's rows of field f of active cell a of
-  // u_j x (reduced over the ranks).
-  void low_rank_dots(const double *x, int f, std::vector<double> &t) const;
-  // x[row] += sum_i u_i w[2a + i] over the rows of field f of active cell a.
-  void low_rank_add(const std::vector<double> &w, int f, double *x) const;
   // The full (replicated) state from a distributed vector.
   void gather(const Epetra_Vector &x, std::vector<double> &full) const;
 
   Epetra_MpiComm comm_;
   sp_solver_options options_;
   std::unique_ptr<Assembly> assembly_;
-  std::unique_ptr<DirectSolver> direct_;
+  // The backend of solver.linear inside the low-rank (Woodbury) wrapper.
+  std::unique_ptr<LowRankSolver> linear_;
   std::vector<int> csr_ptr_, csr_col_;  // this rank's rows: pattern, global columns (sorted)
   std::vector<int> csr_from_;           // position of each entry in its Epetra row
   int first_row_ = 0, n_global_ = 0;    // the rows are first_row_ .. + n_rows - 1
@@ -90,16 +88,7 @@ class Solver {
   int step_factorisations_ = 0;  // factorisations in the current step
   std::vector<double> step_norms_;  // ||F|| at the guess and after each iteration
   std::vector<double> full_;     // scratch: the replicated state
-  // Implicit shape term of the current step (empty when explicit).
-  std::vector<double> shape_u_;            // 2 per pair (Assembly::shape_weights)
-  std::vector<sp_shape_coef> shape_coef_;  // the coefficients at the last state
-  sp_step_data shape_data_{};              // the step data pointing at them
-  std::vector<int> active_of_cell_;        // cell -> active index or -1
-  std::vector<double> low_rank_c_;        // 4 per active cell: C = -gain[i][j]
-  std::vector<int> row_active_;            // this rank's rows: active index or -1
-  std::vector<double> woodbury_lu_;        // K = I + C V^T A^-1 U, LU in place
-  std::vector<double> woodbury_z_;         // Z = A^-1 U, this rank's rows, by column
-  std::vector<int> woodbury_piv_;
+  ImplicitShape shape_;          // the current step's implicit shape term
 };
 
 }  // namespace sp

@@ -131,6 +131,7 @@ static const cyaml_strval_t sp_linear_words[] = {
     {"superlu", SP_LINEAR_SUPERLU},
     {"superlu_dist", SP_LINEAR_SUPERLU_DIST},
     {"mumps", SP_LINEAR_MUMPS},
+    {"klu", SP_LINEAR_KLU},
     {"klu2", SP_LINEAR_KLU2},
     {"gmres_ilu", SP_LINEAR_GMRES_ILU}};
 static const cyaml_strval_t sp_ordering_words[] = {
@@ -313,8 +314,9 @@ static const sp_key sp_keys[] = {
     KEY_ENUM(SP_SEC_SOLVER, "linear", solver.linear, SP_LINEAR_MUMPS,
              sp_linear_words, "-",
              "linear solver of each Newton step: direct (superlu, "
-             "superlu_dist, mumps, klu2) or GMRES with an ILU(k) "
-             "preconditioner (gmres_ilu)"),
+             "superlu_dist, mumps, klu: Amesos' KLU, klu2: Amesos2's KLU2, "
+             "one process) or GMRES with an ILU(k) preconditioner "
+             "(gmres_ilu)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
               ABOVE(0.0), BELOW(1.0), "-",
               "Newton: residual reduction relative to the first residual"),

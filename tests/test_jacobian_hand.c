@@ -2,15 +2,19 @@
  *  - equals the AD one to 1e-12 relative (and AD equals central differences
  *    to 1e-6; DFad equals SFad) on random states with 1 to 4 overlapping
  *    cells, on a rectangle and on an ellipse with a buffer ring, with a
- *    source and the explicit shape term present;
+ *    source and the explicit shape term present; the same with 5 and 6
+ *    cells on every element, where AD itself is DFad (SFad is compiled for
+ *    1-4 cells);
  *  - the same on a state just after a sharp division cut;
  *  - Newton takes the same iterations with ad and hand on steps of a
  *    3-cell scene (test_newton.c's), to the same states (1e-10);
- *  - `softpack check-jacobian` on tests/scenes/two_overlapping.yaml exits 0
- *    and prints the hand-vs-ad figure. */
+ *  - `softpack check-jacobian` on tests/scenes/two_overlapping.yaml and on
+ *    tests/scenes/five_overlapping.yaml (5 cells on every element: DFad)
+ *    exits 0, and the figures it prints, at the initial state and after a
+ *    step, are hand = ad to 1e-12 and ad = fd to 1e-6. */
 #include <string.h>
-#include <sys/wait.h>
 
+#include "command.h"
 #include "fixtures.h"
 
 static double compare(sp_solver s, const sp_step_data *data, const double *state, int a,
@@ -55,7 +59,7 @@ static void random_state(const sp_mesh *mesh, int n_cells, unsigned long long se
     old[i] = 0.5 + 0.5 * sp_random_symmetric(&rng);
   }
   for (int p = 0; p < layout->n_pairs; ++p) source[p] = 50 * sp_random_symmetric(&rng);
-  sp_shape_coef shape[4];
+  sp_shape_coef shape[8];
   for (int k = 0; k < n_cells; ++k) {
     double th = 0.3 + k;
     shape[k] = (sp_shape_coef){.xc = 0.1 * k, .yc = -0.05 * k,
@@ -147,22 +151,27 @@ static void newton_same_iterations(void) {
   free(u_ad); free(u_hand); free(old_ad); free(old_hand);
 }
 
-static void command_line(void) {
-  char cmd[4096], out[16384];
-  snprintf(cmd, sizeof cmd,
-           "OMP_NUM_THREADS=1 %s check-jacobian %s/tests/scenes/two_overlapping.yaml "
-           "--steps 1 --set mesh.nx=16 --set mesh.ny=16 2>&1", SP_BINARY, SP_SOURCE_DIR);
-  FILE *p = popen(cmd, "r");
-  CHECK(p != NULL, "popen failed");
-  if (!p) return;
-  size_t len = fread(out, 1, sizeof out - 1, p);
-  out[len] = '\0';
-  int status = pclose(p);
-  int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  printf("--- softpack check-jacobian (exit status %d) ---\n%s---\n", code, out);
-  CHECK(code == 0, "check-jacobian exit status %d", code);
-  CHECK(strstr(out, "hand vs ad") != NULL, "no hand-vs-ad figure printed");
-  CHECK(strstr(out, ": ok") != NULL, "hand vs ad not reported ok");
+/* `softpack check-jacobian SCENE --steps 1 EXTRA`: exit status 0, and the
+ * "all terms" row of both tables (the initial state, after one step) read
+ * back: hand = ad to 1e-12, ad = fd to 1e-6. */
+static void command_line(const char *scene, const char *extra) {
+  char args[2048], out[16384];
+  snprintf(args, sizeof args, "check-jacobian %s/tests/scenes/%s --steps 1 %s", SP_SOURCE_DIR,
+           scene, extra);
+  const int code = run_softpack(args, out, sizeof out);
+  printf("--- softpack check-jacobian %s (exit status %d) ---\n%s---\n", scene, code, out);
+  CHECK(code == 0, "%s: check-jacobian exit status %d", scene, code);
+  int tables = 0;
+  for (const char *row = strstr(out, "all terms"); row; row = strstr(row + 1, "all terms")) {
+    double hand_ad = -1, ad_fd = -1, hand_fd = -1;
+    CHECK(sscanf(row, "all terms %lf %lf %lf", &hand_ad, &ad_fd, &hand_fd) == 3,
+          "%s, table %d: cannot read the all-terms row", scene, tables + 1);
+    CHECK(hand_ad >= 0 && hand_ad <= 1e-12, "%s, table %d: hand vs ad %g", scene, tables + 1,
+          hand_ad);
+    CHECK(ad_fd >= 0 && ad_fd <= 1e-6, "%s, table %d: ad vs fd %g", scene, tables + 1, ad_fd);
+    ++tables;
+  }
+  CHECK(tables == 2, "%s: %d tables (want the initial state and after one step)", scene, tables);
 }
 
 int main(int argc, char **argv) {
@@ -170,7 +179,8 @@ int main(int argc, char **argv) {
   sp_mesh *rect, *ellipse;
   CHECK_OK(sp_mesh_rectangle(0, 0, 1, 0.8, 6, 5, &rect));
   CHECK_OK(sp_mesh_ellipse(2, 0.5, 0.25, 2, 0.2, &ellipse)); /* with a buffer ring */
-  for (int n_cells = 1; n_cells <= 4; ++n_cells) {
+  /* 1 to 4 cells on every element: AD is SFad; 5 and 6: AD is DFad */
+  for (int n_cells = 1; n_cells <= 6; ++n_cells) {
     random_state(rect, n_cells, 17 + n_cells, "rectangle");
     random_state(ellipse, n_cells, 91 + n_cells, "ellipse+buffer");
   }
@@ -178,7 +188,8 @@ int main(int argc, char **argv) {
   sp_mesh_destroy(&ellipse);
   division_cut();
   newton_same_iterations();
-  command_line();
+  command_line("two_overlapping.yaml", "--set mesh.nx=16 --set mesh.ny=16");
+  command_line("five_overlapping.yaml", ""); /* 5 cells on every element: DFad */
   MPI_Finalize();
   TEST_DONE();
 }

@@ -79,9 +79,12 @@ int main(int argc, char **argv) {
   printf("ILU(0), first step: %s, %d Newton and %ld GMRES iterations (ILU(2): %ld) %s\n",
          failed0 ? "failed" : "converged", rep0.newton_its, rep0.linear_its, ilu2_first_gmres,
          failed0 ? rep0.reason : "");
-  CHECK(failed0 ? strstr(rep0.reason, "GMRES") != NULL : rep0.linear_its != ilu2_first_gmres,
-        "ILU(0): %s with %ld GMRES iterations, as ILU(2)", failed0 ? rep0.reason : "converged",
-        rep0.linear_its);
+  /* failed: only through a failed GMRES solve, which ends the attempt
+   * before Newton's own limit */
+  CHECK(failed0 ? rep0.newton_its < opt.newton_max_its && rep0.linear_its > 0
+                : rep0.linear_its != ilu2_first_gmres,
+        "ILU(0): %s with %ld GMRES iterations (ILU(2): %ld)", failed0 ? rep0.reason : "converged",
+        rep0.linear_its, ilu2_first_gmres);
   sp_solver_destroy(&ilu0);
   free(z);
 
@@ -94,7 +97,12 @@ int main(int argc, char **argv) {
   sp_step_report rep;
   CHECK(sp_solver_step(strict, &data, y, &rep) == 1, "a step with krylov_tol 1e-30 succeeded");
   printf("krylov_tol 1e-30: %s\n", rep.reason);
-  CHECK(strstr(rep.reason, "GMRES: no convergence") != NULL, "reason: %s", rep.reason);
+  /* the first linear solve failed: no Newton update was made, after one
+   * factorisation and some GMRES iterations */
+  CHECK(rep.converged == 0 && rep.newton_its == 0 && rep.factorisations == 1 &&
+            rep.linear_its > 0,
+        "reason: %s; %d Newton iterations, %d factorisations, %ld GMRES iterations", rep.reason,
+        rep.newton_its, rep.factorisations, rep.linear_its);
   CHECK(memcmp(y, x[0], sizeof(double) * n) == 0, "the failed step changed the state");
   sp_solver_destroy(&strict);
   free(y);

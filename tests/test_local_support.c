@@ -9,7 +9,10 @@
  * - a cell pushed across the mesh keeps its mass to 1e-10 across support
  *   changes (which do happen), and the mass the changes drop in all (the
  *   run's total, like the division run's below) stays below 1e-10;
- * - supports reaching the domain boundary and the buffer ring behave;
+ * - supports reaching the domain boundary and the buffer ring behave: each
+ *   cell's mass is kept to 1e-10 at every step, and the energy law of
+ *   backward Euler holds at every step (no rise beyond round-off, except
+ *   the rise a support change itself reports);
  * - after a division the children's supports cover the children. */
 #include <string.h>
 
@@ -57,6 +60,59 @@ static double first_and_last_energy(const char *path, double *first) {
   }
   free(t.v);
   return e;
+}
+
+/* The edge scene (backward Euler, no source, no shape term, no division):
+ * - mass: every cell's mass at every step of cells.csv equals its first to
+ *   1e-10 relative (each step conserves it to round-off, 1e-12 per step
+ *   asserted by test_conservation; a support change restores what it cut,
+ *   and the run summary's dropped mass is below 1e-10);
+ * - energy: a step minimises the energy plus the H^-1 distance to its
+ *   start (docs/model.md), so energy.csv never rises from one row to the
+ *   next beyond round-off (1e-13 relative, as test_energy), except on a row
+ *   whose step changed the supports: its energy is logged after the change,
+ *   which may raise it by at most the run's largest reported rise. */
+static void check_edge_laws(const char *dir, const sp_run_summary *sum) {
+  char path[256];
+  csv_table cells, energy;
+  snprintf(path, sizeof path, "%s/cells.csv", dir);
+  CHECK(csv_read(path, &cells) == 0 && cells.n_rows > 0, "%s", path);
+  snprintf(path, sizeof path, "%s/energy.csv", dir);
+  CHECK(csv_read(path, &energy) == 0 && energy.n_rows > 1, "%s", path);
+  if (sp_test_failures) return;
+  double first_mass[2] = {NAN, NAN}, worst_mass = 0;
+  int steps_seen = 0;
+  for (int i = 0; i < cells.n_rows; ++i) {
+    const int cell = (int)at(&cells, i, "cell");
+    CHECK(cell == 1 || cell == 2, "row %d: cell %d (no division expected)", i, cell);
+    if (cell != 1 && cell != 2) continue;
+    const double m = at(&cells, i, "mass");
+    if (isnan(first_mass[cell - 1])) first_mass[cell - 1] = m;
+    worst_mass = fmax(worst_mass, fabs(m / first_mass[cell - 1] - 1));
+    steps_seen += cell == 1;
+  }
+  int rises = 0, changes = 0;
+  double worst_rise = 0;
+  for (int i = 1; i < energy.n_rows; ++i) {
+    const double e0 = at(&energy, i - 1, "energy"), e1 = at(&energy, i, "energy");
+    const int changed = at(&energy, i, "support_changed") == 1;
+    changes += changed;
+    const double allowed = (changed ? sum->support_energy_rise : 0.0) + 1e-13;
+    if (e1 > e0 + allowed * fabs(e0)) ++rises;
+    if (!changed) worst_rise = fmax(worst_rise, (e1 - e0) / fabs(e0));
+  }
+  printf("edge scene laws: %d steps in cells.csv, largest relative mass change %.2e; energy: "
+         "%d rows, %d with a support change (reported rise at most %.2e), largest rise on the "
+         "others %.2e, %d rows break the law\n", steps_seen, worst_mass, energy.n_rows, changes,
+         sum->support_energy_rise, worst_rise, rises);
+  CHECK(steps_seen == sum->steps + 1, "cells.csv has %d steps of %d", steps_seen,
+        sum->steps + 1);
+  CHECK(worst_mass <= 1e-10, "a cell's mass changed by %.3g relative", worst_mass);
+  CHECK(changes == sum->layout_changes, "energy.csv marks %d support changes, the run %d",
+        changes, sum->layout_changes);
+  CHECK(rises == 0, "the energy rose beyond the law on %d rows", rises);
+  free(cells.v);
+  free(energy.v);
 }
 
 static sp_run_summary run(const char *scene_file, int n_set, const char **set, const char *out) {
@@ -240,6 +296,8 @@ int main(int argc, char **argv) {
          "restored %.2e, largest energy rise at a change %.2e\n", b.steps, b.layout_changes,
          b.unknowns_max, b.support_mass_correction, b.support_energy_rise);
   CHECK(b.steps > 0 && fabs(b.t_final - 0.004) < 1e-12, "edge scene reached t = %g", b.t_final);
+  CHECK(b.layout_changes >= 1, "the edge scene's supports never changed: nothing tested");
+  check_edge_laws("local_edge", &b);
 
   /* 4. division under local supports */
   const char *div_set[] = {"layout.support=local"};

@@ -202,6 +202,18 @@ static void test_overrides(void) {
   CHECK_NEAR(s->model.alpha, 4.0, 0.0);  /* untouched keys keep theirs */
   sp_scene_destroy(&s);
 
+  /* the two KLUs are different backends: klu (Amesos), klu2 (Amesos2) */
+  static const struct {
+    const char *set;
+    sp_linear_kind want;
+  } klu[] = {{"solver.linear=klu", SP_LINEAR_KLU}, {"solver.linear=klu2", SP_LINEAR_KLU2}};
+  for (size_t i = 0; i < sizeof klu / sizeof klu[0]; ++i) {
+    CHECK_OK(sp_scene_load(path, 1, &klu[i].set, &s));
+    CHECK(s && s->solver.linear == klu[i].want, "%s: linear %d", klu[i].set,
+          s ? (int)s->solver.linear : -1);
+    sp_scene_destroy(&s);
+  }
+
   /* each bad override alone: SP_ERR_INPUT, the key in the message */
   static const struct {
     const char *set, *want;

@@ -10,6 +10,7 @@
 #include "check.h"
 #include "command.h"
 #include "scene.h"
+#include "softpack_solver.h"
 
 /** The text after "key: " up to the end of its line, or "" if absent. */
 static void line_after(const char *text, const char *key, char *value, size_t size) {
@@ -46,13 +47,21 @@ int main(int argc, char **argv) {
   CHECK(strcmp(value, SP_TRILINOS_VERSION) == 0, "Trilinos '%s', want '%s'", value,
         SP_TRILINOS_VERSION);
   /* Debian's Trilinos serves every solver the scene accepts. */
-  for (int kind = SP_LINEAR_SUPERLU; kind <= SP_LINEAR_GMRES_ILU; ++kind) {
+  for (int kind = SP_LINEAR_SUPERLU; kind <= SP_LINEAR_LAST; ++kind) {
     char key[64];
     snprintf(key, sizeof key, "  %s ", sp_scene_linear_name((sp_linear_kind)kind));
     line_after(out, key, value, sizeof value);
     CHECK(value[0] != '\0', "info lists no linear solver '%s'", key);
     CHECK(strstr(value, "not in this build") == NULL, "%s: %s", key, value);
   }
+  /* klu2 is served by Amesos2, klu by Amesos (v1): not one library twice */
+  const char *klu2 = NULL, *klu = NULL;
+  CHECK(sp_solver_linear_backend(SP_SOLVER_KLU2, &klu2) == 1 && klu2 &&
+            strstr(klu2, "Amesos2") != NULL,
+        "klu2 is served by '%s', want Amesos2", klu2 ? klu2 : "(none)");
+  CHECK(sp_solver_linear_backend(SP_SOLVER_KLU, &klu) == 1 && klu &&
+            strstr(klu, "Amesos") != NULL && strstr(klu, "Amesos2") == NULL,
+        "klu is served by '%s', want Amesos (v1)", klu ? klu : "(none)");
   /* The BLAS line names a file that exists. */
   line_after(out, "BLAS: ", value, sizeof value);
   const char *from = strstr(value, "dgemm_ from ");

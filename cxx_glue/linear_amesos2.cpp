@@ -1,0 +1,127 @@
+// KLU2 through Amesos2 on an Epetra copy of the CSR rows (epetra_rows.hpp):
+// solver.linear: klu2. One process only: Debian 13.2's Amesos2 returns wrong
+// solutions with several ranks (STACK.md), so Solver refuses klu2 there and
+// this backend checks it again. Amesos2's symbolic factorisation (KLU's
+// ordering) is done once per pattern, each factor() overwrites the values
+// in place and refactors numerically.
+#include <Amesos2.hpp>
+#include <Epetra_MultiVector.h>
+#include <Kokkos_Core.hpp>
+#include <Teuchos_RCP.hpp>
+#include <Trilinos_version.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <exception>
+#include <stdexcept>
+#include <vector>
+
+#include "epetra_rows.hpp"
+#include "linear.hpp"
+
+namespace sp {
+namespace {
+
+// Amesos2 keeps its arrays in Kokkos views, which need Kokkos initialised
+// (the Serial space in Debian's build: no threads). Done once per process,
+// finalised at exit if we started it.
+void ensure_kokkos() {
+  if (Kokkos::is_initialized()) return;
+  Kokkos::initialize();
+  std::atexit([] {
+    if (Kokkos::is_initialized()) Kokkos::finalize();
+  });
+}
+
+class Amesos2Klu2 final : public DirectSolver {
+ public:
+  explicit Amesos2Klu2(MPI_Comm comm) : comm_(comm) {
+    if (comm_.NumProc() != 1)
+      throw std::runtime_error("solver.linear: klu2 (Amesos2) runs on one MPI process only");
+    if (!Amesos2::query("KLU2"))
+      throw std::runtime_error("solver.linear: klu2 is not available in this Amesos2 build");
+    ensure_kokkos();
+  }
+  ~Amesos2Klu2() override { release(); }
+
+  bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
+    try {
+      if (!same_pattern || solver_.is_null() || !rows_->same_pattern(A)) build(A);
+      rows_->set_values(A);
+      solver_->numericFactorization();
+      factored_ = true;
+      return true;
+    } catch (const std::exception &e) {
+      // KLU2 throws on a singular matrix ("KLU2 numeric factorization failed")
+      why = std::string("klu2 (Amesos2): factorisation failed (singular matrix?): ") + e.what();
+      factored_ = false;
+      return false;
+    }
+  }
+
+  bool solve(const double *b, double *x, std::string &why) override {
+    return solve_many(b, x, 1, rows_ ? rows_->n_local() : 0, why);
+  }
+
+  bool solve_many(const double *B, double *X, int nrhs, int n_rows, std::string &why) override {
+    if (!factored_) {
+      why = "klu2 (Amesos2): solve without a factorisation";
+      return false;
+    }
+    try {
+      if (!b_ || b_->NumVectors() != nrhs) {
+        b_ = Teuchos::rcp(new Epetra_MultiVector(rows_->matrix().RowMap(), nrhs));
+        x_ = Teuchos::rcp(new Epetra_MultiVector(rows_->matrix().RowMap(), nrhs));
+      }
+      for (int j = 0; j < nrhs; ++j)
+        std::copy(B + (size_t)j * n_rows, B + (size_t)(j + 1) * n_rows, (*b_)[j]);
+      solver_->solve(x_.ptr(), b_.ptr().getConst());
+      for (int j = 0; j < nrhs; ++j)
+        std::copy((*x_)[j], (*x_)[j] + n_rows, X + (size_t)j * n_rows);
+      return true;
+    } catch (const std::exception &e) {
+      why = std::string("klu2 (Amesos2): solve failed: ") + e.what();
+      return false;
+    }
+  }
+
+  int symbolic_count() const override { return symbolic_; }
+
+ private:
+  void release() {
+    solver_ = Teuchos::null;
+    b_ = x_ = Teuchos::null;
+    rows_.reset();
+    factored_ = false;
+  }
+
+  void build(const CsrRows &A) {
+    release();
+    rows_ = std::make_unique<EpetraRows>(comm_, A);
+    Teuchos::RCP<const Epetra_CrsMatrix> matrix = Teuchos::rcpFromRef(rows_->matrix());
+    solver_ = Amesos2::create<Epetra_CrsMatrix, Epetra_MultiVector>("KLU2", matrix);
+    solver_->symbolicFactorization();
+    ++symbolic_;
+  }
+
+  Epetra_MpiComm comm_;
+  std::unique_ptr<EpetraRows> rows_;
+  Teuchos::RCP<Amesos2::Solver<Epetra_CrsMatrix, Epetra_MultiVector>> solver_;
+  Teuchos::RCP<Epetra_MultiVector> b_, x_;
+  bool factored_ = false;
+  int symbolic_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<DirectSolver> make_amesos2_klu2(MPI_Comm comm) {
+  return std::make_unique<Amesos2Klu2>(comm);
+}
+
+bool amesos2_klu2_available() { return Amesos2::query("KLU2"); }
+
+const char *amesos2_klu2_version() {
+  return "KLU2 through Amesos2 (Trilinos " TRILINOS_VERSION_STRING "; one process only)";
+}
+
+}  // namespace sp
