@@ -11,11 +11,13 @@
 #include "division.h"
 #include "dt_control.h"
 #include "error.h"
+#include "fault.h"
 #include "layout.h"
 #include "output.h"
 #include "partition.h"
 #include "render.h"
 #include "shape.h"
+#include "solver_status.h"
 #include "source.h"
 #include "support.h"
 #include "time_scheme.h"
@@ -65,10 +67,9 @@ int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *lay
   sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
   sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
                        layout->pair_cell, first_node, n_ranks};
-  const int failed = sp_solver_set_problem(solver, &mv, &lv) != 0;
+  const int status = sp_solver_set_problem(solver, &mv, &lv);
   free(first_node);
-  if (failed)
-    return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(solver));
+  if (status != SP_SOLVER_OK) return sp_solver_failed(solver, status, "solver setup");
   return SP_OK;
 }
 
@@ -134,8 +135,8 @@ static void core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
 
 /** The energy parts of the fields (without the shape term) of the run's state. */
 static int state_energy(sp_run *run, sp_energy_parts *parts) {
-  if (sp_solver_energy(run->solver, &run->model, run->state, parts) != 0)
-    return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
+  const int status = sp_solver_energy(run->solver, &run->model, run->state, parts);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "energy");
   return SP_OK;
 }
 
@@ -546,9 +547,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     seconds.assembly += report.t_assembly;
     seconds.factorisation += report.t_factor;
     seconds.solves += report.t_solve;
-    if (solved > 1) {
-      rc = sp_error_set(SP_ERR_SOLVER, "step %d at t = %g: %s", step + 1, t,
-                        sp_solver_last_error(run->solver));
+    if (solved > SP_SOLVER_NOT_CONVERGED) {
+      rc = sp_solver_failed(run->solver, solved, "step %d at t = %g", step + 1, t);
       break;
     }
     double err = -1.0;
@@ -748,11 +748,12 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
   MPI_Comm_size(comm, &run->n_ranks);
   SP_CALL(sp_mesh_from_scene(scene, &run->mesh));
   SP_CALL(sp_layout_create_full(run->mesh->n_nodes, scene->n_cells, &run->layout));
+  SP_CALL(sp_fault_check(SP_FAULT_SETUP, run->rank));
   sp_solver_options opt;
   sp_solver_options_from_scene(scene, &opt);
   sp_model_from_scene(scene, &run->model);
-  if (sp_solver_create(comm, &opt, &run->solver) != 0)
-    return sp_error_set(SP_ERR_INPUT, "solver: %s", sp_solver_last_error(run->solver));
+  const int status = sp_solver_create(comm, &opt, &run->solver);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "solver");
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
   const int n = scene->n_cells;
   SP_ALLOC(run->state, n_values);
