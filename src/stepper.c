@@ -10,6 +10,7 @@
 #include "cells.h"
 #include "division.h"
 #include "dt_control.h"
+#include "agree.h"
 #include "error.h"
 #include "fault.h"
 #include "layout.h"
@@ -119,6 +120,8 @@ typedef struct {
   sp_run_summary *sum;
   sp_division_params division;
   MPI_Comm comm;
+  MPI_Comm agree_comm; /* errors are agreed on it before every collective
+                          (agree.h); MPI errors return codes there */
   sp_step_callback on_step; /* may be NULL */
   void *on_step_user;
   double t_start;           /* wall clock at the run's start */
@@ -135,6 +138,7 @@ static void core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
 
 /** The energy parts of the fields (without the shape term) of the run's state. */
 static int state_energy(sp_run *run, sp_energy_parts *parts) {
+  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* a collective follows */
   const int status = sp_solver_energy(run->solver, &run->model, run->state, parts);
   if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "energy");
   return SP_OK;
@@ -176,6 +180,7 @@ static int record_energy(sp_run *run, int step, double t, double dt, int its,
 }
 
 static int write_snapshot(sp_run *run, int step, double t) {
+  SP_CALL(sp_fault_check(SP_FAULT_OUTPUT, run->rank));
   if (run->n_ranks > 1) { /* a piece per rank, the .pvtu by rank 0 */
     int *first_node;
     SP_ALLOC(first_node, (size_t)run->n_ranks + 1);
@@ -236,6 +241,7 @@ static int adopt_layout(sp_run *run, sp_layout *layout, double *state) {
   run->layout = layout;
   run->state = state;
   SP_CALL(alloc_step_buffers(run));
+  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* a collective follows */
   return sp_solver_attach(run->solver, run->mesh, run->layout);
 }
 
@@ -526,6 +532,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
         run->state[i] = run->state_old[i] + r * (run->state_old[i] - prev[i]);
     }
     rc = explicit_terms(run, &shape_coef);
+    if (rc == SP_OK) rc = sp_fault_check(SP_FAULT_STEP, run->rank);
+    rc = sp_agree(run->agree_comm, rc); /* Newton's collectives follow */
     if (rc != SP_OK) break;
     const sp_scheme_kind kind = sp_scheme_of_step(scheme, &run->hist);
     double dt_eff = dt_try;
@@ -635,9 +643,11 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     int n_divided = 0, have_energy = 0;
     sp_energy_parts energy_after_supports;
     if (rc == SP_OK) rc = divide_due_cells(run, t_old, t, step, core_mass_old, &n_divided);
+    int outgrown = 0; /* a cell reaches its support's edge */
+    if (rc == SP_OK && run->support && !n_divided)
+      rc = sp_support_needs_update(run->support, run->layout, run->state, &outgrown);
     if (rc != SP_OK) break;
-    if (rc == SP_OK && run->support &&
-        (n_divided || sp_support_needs_update(run->support, run->layout, run->state))) {
+    if (run->support && (n_divided || outgrown)) {
       const double t_layout = run->sum->t_layout;
       rc = update_supports(run, &energy_after_supports);
       have_energy = rc == SP_OK;
@@ -677,8 +687,15 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                                  .wall_seconds = wall_clock() - run->t_start,
                                  .last = ends};
       stop = run->on_step(&info, run->on_step_user) != 0;
-      if (run->n_ranks > 1) /* any rank's stop stops every rank */
-        MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, run->comm);
+      if (run->n_ranks > 1) { /* any rank's stop stops every rank */
+        rc = sp_agree(run->agree_comm, SP_OK);
+        if (rc == SP_OK) {
+          const int mpi_rc = MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX,
+                                           run->agree_comm);
+          if (mpi_rc != MPI_SUCCESS) rc = sp_mpi_error(mpi_rc, "MPI_Allreduce (stop)");
+        }
+        if (rc != SP_OK) break;
+      }
       sum->stopped = stop;
     }
     if (step % run->scene->output.every == 0 || ends || stop || n_divided ||
@@ -694,6 +711,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
 }
 
 static void run_free(sp_run *run) {
+  sp_agree_comm_free(&run->agree_comm);
   sp_output_close(&run->output);
   sp_solver_destroy(&run->solver);
   sp_layout_destroy(&run->layout);
@@ -744,14 +762,15 @@ static int renumber_rcb(sp_run *run) {
 
 static int run_setup(sp_run *run, MPI_Comm comm) {
   const sp_scene *scene = run->scene;
-  MPI_Comm_rank(comm, &run->rank);
-  MPI_Comm_size(comm, &run->n_ranks);
+  SP_MPI_CALL(MPI_Comm_rank(run->agree_comm, &run->rank));
+  SP_MPI_CALL(MPI_Comm_size(run->agree_comm, &run->n_ranks));
   SP_CALL(sp_mesh_from_scene(scene, &run->mesh));
   SP_CALL(sp_layout_create_full(run->mesh->n_nodes, scene->n_cells, &run->layout));
   SP_CALL(sp_fault_check(SP_FAULT_SETUP, run->rank));
   sp_solver_options opt;
   sp_solver_options_from_scene(scene, &opt);
   sp_model_from_scene(scene, &run->model);
+  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* creating the solver is collective */
   const int status = sp_solver_create(comm, &opt, &run->solver);
   if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "solver");
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
@@ -810,6 +829,7 @@ static int run_setup(sp_run *run, MPI_Comm comm) {
     SP_CALL(adopt_layout(run, layout, state));
     SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold, run->obs));
   } else {
+    SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* attaching is collective */
     SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   }
   /* (With local supports the solver sees only the local layout: the full
@@ -833,17 +853,18 @@ int sp_stepper_run_with(const sp_scene *scene, const char *out_dir, MPI_Comm com
   sp_run_summary sum = {0};
   const double t0 = wall_clock();
   sp_run run = {.scene = scene, .sum = &sum, .out_dir = out_dir, .comm = comm,
-                .on_step = on_step, .on_step_user = user, .t_start = t0};
-  int rc = run_setup(&run, comm);
-  /* Only now, with the input known good, does anything get written. */
-  if (rc == SP_OK && run.rank == 0) rc = sp_output_open(out_dir, &run.output);
-  if (run.n_ranks > 1) { /* the other ranks write pieces into rank 0's directory */
-    int failed = rc != SP_OK, any_failed = 0;
-    MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, comm);
-    if (any_failed && !failed)
-      rc = sp_error_set(SP_ERR_IO, "another rank failed before the run began (see its message)");
+                .agree_comm = MPI_COMM_NULL, .on_step = on_step, .on_step_user = user,
+                .t_start = t0};
+  int rc = sp_agree_comm_create(comm, &run.agree_comm);
+  if (rc == SP_OK) {
+    rc = sp_agree(run.agree_comm, run_setup(&run, comm));
+    /* Only now, with the input known good on every rank, does anything
+     * get written (the other ranks write pieces into rank 0's directory). */
+    if (rc == SP_OK && run.rank == 0) rc = sp_output_open(out_dir, &run.output);
+    if (rc == SP_OK) rc = run_steps(&run, &sum);
+    /* A rank that failed alone meets here the other ranks' next agreement. */
+    rc = sp_agree(run.agree_comm, rc);
   }
-  if (rc == SP_OK) rc = run_steps(&run, &sum);
   sum.wall_seconds = wall_clock() - t0;
   if (summary) *summary = sum;
   run_free(&run);
