@@ -47,3 +47,11 @@ int sp_agree(MPI_Comm comm, int rc) {
   sp_error_mark_agreed(1);
   return code;
 }
+
+int sp_agree_any(MPI_Comm comm, int *flag) {
+  SP_CALL(sp_agree(comm, SP_OK));
+  int any = *flag != 0;
+  SP_MPI_CALL(MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, comm));
+  *flag = any;
+  return SP_OK;
+}

@@ -55,6 +55,13 @@ void sp_agree_comm_free(MPI_Comm *comm);
  */
 int sp_agree(MPI_Comm comm, int rc);
 
+/**
+ * @brief Collective: sp_agree(comm, SP_OK), then @p flag becomes 1 on every
+ *        rank if it is non-zero on any (e.g. a callback's "stop").
+ * @return SP_OK, or the agreed error (@p flag unchanged)
+ */
+int sp_agree_any(MPI_Comm comm, int *flag);
+
 #ifdef __cplusplus
 }
 #endif

@@ -7,10 +7,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "agree.h"
 #include "cells.h"
 #include "division.h"
 #include "dt_control.h"
-#include "agree.h"
 #include "error.h"
 #include "fault.h"
 #include "layout.h"
@@ -687,15 +687,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                                  .wall_seconds = wall_clock() - run->t_start,
                                  .last = ends};
       stop = run->on_step(&info, run->on_step_user) != 0;
-      if (run->n_ranks > 1) { /* any rank's stop stops every rank */
-        rc = sp_agree(run->agree_comm, SP_OK);
-        if (rc == SP_OK) {
-          const int mpi_rc = MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX,
-                                           run->agree_comm);
-          if (mpi_rc != MPI_SUCCESS) rc = sp_mpi_error(mpi_rc, "MPI_Allreduce (stop)");
-        }
-        if (rc != SP_OK) break;
-      }
+      rc = sp_agree_any(run->agree_comm, &stop); /* any rank's stop stops every rank */
+      if (rc != SP_OK) break;
       sum->stopped = stop;
     }
     if (step % run->scene->output.every == 0 || ends || stop || n_divided ||

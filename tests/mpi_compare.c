@@ -22,7 +22,8 @@
  *     creation, in a step, at output; rank 1, and rank 0 for some),
  *     sp_run_file returns on every rank with the fault's class
  *     (memory, solver, output) and a message naming it; then a run without
- *     a fault succeeds on every rank (the library is usable after them).
+ *     a fault succeeds on every rank (the library is usable after them),
+ *     stopped after step 2 on every rank by a callback that stops on rank 1.
  *
  *   mpi_compare faults         (run without mpirun)
  *     The real program under `mpirun -np 2` with a fault on rank 1 at
@@ -324,6 +325,11 @@ static int cmd_iterates(int argc, char **argv, int rank, int size) {
 
 /* ---------- library: faults on one rank, every rank returns ---------- */
 
+/** A step callback that stops the run after step 2 on rank 1 only. */
+static int stop_on_rank_1(const sp_step_info *s, void *user) {
+  return *(const int *)user == 1 && s->step >= 2;
+}
+
 static int cmd_library(int argc, char **argv, int rank) {
   if (argc < 1) {
     fprintf(stderr, "usage: mpi_compare library SCENE [key=value]...\n");
@@ -352,9 +358,11 @@ static int cmd_library(int argc, char **argv, int rank) {
           cases[i].fault, sp_error_message());
   }
   sp_run_summary sum = {0};
-  CHECK_OK(sp_run_file(argv[0], argc - 1, set, "mpi_library_out", MPI_COMM_WORLD, NULL, NULL,
-                       &sum));
-  CHECK(sum.steps > 0, "rank %d: the run without a fault made no step", rank);
+  CHECK_OK(sp_run_file(argv[0], argc - 1, set, "mpi_library_out", MPI_COMM_WORLD,
+                       stop_on_rank_1, &rank, &sum));
+  CHECK(sum.stopped == 1 && sum.steps == 2,
+        "rank %d: rank 1's stop after step 2: stopped %d after %d steps", rank, sum.stopped,
+        sum.steps);
   return 0;
 }
 
