@@ -3,8 +3,8 @@
  * @brief The only door from the C core into the C++/Trilinos glue.
  *
  * Plain C, an opaque handle, error codes, no Trilinos types. Every entry point
- * catches every exception and returns a code; the message is kept in the
- * handle (sp_solver_last_error).
+ * catches every exception and returns a code (sp_solver_status: the class of
+ * the error); the message is kept in the handle (sp_solver_last_error).
  *
  * The unknowns follow a layout (src/layout.h): pairs (cell, node), numbered
  * node-major, two unknowns per pair: state[2p] = c, state[2p+1] = mu.
@@ -19,6 +19,25 @@ extern "C" {
 #endif
 
 #define SP_MAX_NEWTON_HISTORY 64
+
+/**
+ * What every entry point returns: 0, Newton's failure to converge
+ * (sp_solver_step only: retry with a smaller dt), or the class of a hard
+ * error. The C core maps the classes to its own codes (src/solver_status.h)
+ * and so to exit statuses: only SP_SOLVER_ERR_INPUT is bad input (exit 2),
+ * every other class exits 1 (docs/robustness.md).
+ */
+typedef enum {
+  SP_SOLVER_OK = 0,
+  SP_SOLVER_NOT_CONVERGED = 1, /**< sp_solver_step: Newton did not converge */
+  SP_SOLVER_ERR_INPUT = 2,     /**< options the glue refuses (the scene key is
+                                    named), or a backend this build lacks */
+  SP_SOLVER_ERR_MEMORY = 3,    /**< out of memory (std::bad_alloc) */
+  SP_SOLVER_ERR_SOLVER = 4,    /**< a library failed: Trilinos, NOX, a linear
+                                    solver (e.g. a singular factorisation) */
+  SP_SOLVER_ERR_MPI = 5,       /**< an MPI call failed */
+  SP_SOLVER_ERR_INTERNAL = 6   /**< a bug: an invariant or argument check */
+} sp_solver_status;
 
 /**
  * Jacobian of the element residual: Sacado forward AD (SFad for 1-4 cells on
@@ -162,7 +181,12 @@ typedef struct {
   double bulk, gradient, repulsion, buffer;
 } sp_energy_parts;
 
-/** @brief Create a solver on @p comm with @p options. */
+/**
+ * @brief Create a solver on @p comm with @p options (collective on @p comm).
+ * @return SP_SOLVER_OK, SP_SOLVER_ERR_INPUT for options it refuses (e.g.
+ *         klu2 on several processes), or another class. On failure *out may
+ *         still hold a handle carrying the message: destroy it.
+ */
 int sp_solver_create(MPI_Comm comm, const sp_solver_options *options,
                      sp_solver *out);
 
@@ -184,8 +208,8 @@ int sp_solver_refactor_next(sp_solver s);
  * @brief One backward-Euler step by Newton. On entry @p state is the initial
  *        guess; on success it holds the new state. On failure it is restored
  *        to its value on entry and report->reason says why.
- * @return 0 on success, 1 if Newton did not converge (retry with smaller
- *         dt), other codes for hard errors
+ * @return SP_SOLVER_OK, SP_SOLVER_NOT_CONVERGED (retry with a smaller dt)
+ *         or the sp_solver_status class of a hard error
  */
 int sp_solver_step(sp_solver s, const sp_step_data *data, double *state,
                    sp_step_report *report);

@@ -1,11 +1,14 @@
 // The extern "C" door: argument checks, try/catch, codes. No exception
 // crosses it (NOX also throws const char*, hence catch (...)).
 #include <cstring>
+#include <new>
 #include <stdexcept>
 #include <string>
 
 #include <Trilinos_version.h>
 
+#include "errors.hpp"
+#include "fault.h"
 #include "linear.hpp"
 #include "newton.hpp"
 #include "softpack_solver.h"
@@ -17,20 +20,34 @@ struct sp_solver_s {
 
 namespace {
 
-const int SP_API_ERR = 1;  // a hard error (not a Newton failure)
-
+// Each exception as its class (errors.hpp); the message stays in the handle.
 template <class F> int guarded(sp_solver s, F &&body) {
+  auto keep = [s](const std::string &what) {
+    if (s) s->error = what;
+  };
   try {
     body();
-    return 0;
+    return SP_SOLVER_OK;
+  } catch (const sp::input_error &e) {
+    keep(e.what());
+    return SP_SOLVER_ERR_INPUT;
+  } catch (const std::bad_alloc &e) {
+    keep(std::string("out of memory in the Trilinos glue (") + e.what() + ")");
+    return SP_SOLVER_ERR_MEMORY;
+  } catch (const sp::mpi_error &e) {
+    keep(e.what());
+    return SP_SOLVER_ERR_MPI;
+  } catch (const std::logic_error &e) {
+    keep(e.what());
+    return SP_SOLVER_ERR_INTERNAL;
   } catch (const std::exception &e) {
-    if (s) s->error = e.what();
+    keep(e.what());
   } catch (const char *e) {
-    if (s) s->error = std::string("NOX: ") + e;
+    keep(std::string("NOX: ") + e);
   } catch (...) {
-    if (s) s->error = "unknown exception in the Trilinos glue";
+    keep("unknown exception in the Trilinos glue");
   }
-  return SP_API_ERR + 1;
+  return SP_SOLVER_ERR_SOLVER;
 }
 
 void need(bool ok, const char *what) {
@@ -77,11 +94,25 @@ int sp_solver_linear_backend(int linear, const char **backend) {
 }
 
 int sp_solver_create(MPI_Comm comm, const sp_solver_options *options, sp_solver *out) {
-  if (!options || !out) return SP_API_ERR + 1;
+  if (!options || !out) return SP_SOLVER_ERR_INTERNAL;
   sp_solver s = new (std::nothrow) sp_solver_s;
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_MEMORY;
   *out = s;
-  return guarded(s, [&] { s->impl.reset(new sp::Solver(comm, *options)); });
+  return guarded(s, [&] {
+    // The fault hook (src/fault.h): SOFTPACK_FAULT=solver:RANK fails one
+    // rank as a library would. The ranks agree on it before the solver's
+    // collectives begin, so every rank reports the failure.
+    int rank = 0, faulty = -1, faulty_rank = -1;
+    sp::check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
+    if (sp_fault_due(SP_FAULT_SOLVER, rank)) faulty = rank;
+    sp::check_mpi(MPI_Allreduce(&faulty, &faulty_rank, 1, MPI_INT, MPI_MAX, comm),
+                  "MPI_Allreduce");
+    if (faulty_rank >= 0)
+      throw std::runtime_error("solver creation failed on rank " + std::to_string(faulty_rank) +
+                               " (fault injected by SOFTPACK_FAULT=solver:" +
+                               std::to_string(faulty_rank) + ")");
+    s->impl.reset(new sp::Solver(comm, *options));
+  });
 }
 
 int sp_solver_ranks(sp_solver s) {
@@ -90,7 +121,7 @@ int sp_solver_ranks(sp_solver s) {
 }
 
 int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh, const sp_layout_view *layout) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl != nullptr, "the solver was not created");
     need(mesh && layout, "sp_solver_set_problem: mesh and layout are required");
@@ -99,7 +130,7 @@ int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh, const sp_layout
 }
 
 int sp_solver_refactor_next(sp_solver s) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl != nullptr, "the solver was not created");
     s->impl->refactor_next();
@@ -107,7 +138,7 @@ int sp_solver_refactor_next(sp_solver s) {
 }
 
 int sp_solver_step(sp_solver s, const sp_step_data *data, double *state, sp_step_report *report) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   int newton = 0;
   int rc = guarded(s, [&] {
     need(s->impl != nullptr, "the solver was not created");
@@ -122,7 +153,7 @@ int sp_solver_step(sp_solver s, const sp_step_data *data, double *state, sp_step
 
 int sp_solver_energy(sp_solver s, const sp_model_params *model, const double *state,
                      sp_energy_parts *parts) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl && model && state && parts, "sp_solver_energy: null argument");
     *parts = s->impl->energy(*model, state);
@@ -131,7 +162,7 @@ int sp_solver_energy(sp_solver s, const sp_model_params *model, const double *st
 
 int sp_solver_residual(sp_solver s, const sp_step_data *data, const double *state,
                        double *residual) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl && data && state && residual, "sp_solver_residual: null argument");
     s->impl->residual(*data, state, residual);
@@ -140,7 +171,7 @@ int sp_solver_residual(sp_solver s, const sp_step_data *data, const double *stat
 
 int sp_solver_apply_jacobian(sp_solver s, const sp_step_data *data, const double *state,
                              int transpose, const double *x, double *y) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl && data && state && x && y, "sp_solver_apply_jacobian: null argument");
     s->impl->jacobian_times(*data, state, transpose != 0, x, y);
@@ -149,7 +180,7 @@ int sp_solver_apply_jacobian(sp_solver s, const sp_step_data *data, const double
 
 int sp_solver_check_jacobian(sp_solver s, const sp_step_data *data, const double *state,
                              int jacobian, double *max_rel_err) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl && data && state && max_rel_err, "sp_solver_check_jacobian: null argument");
     need(valid_kind(jacobian), "sp_solver_check_jacobian: unknown kind");
@@ -159,7 +190,7 @@ int sp_solver_check_jacobian(sp_solver s, const sp_step_data *data, const double
 
 int sp_solver_compare_jacobians(sp_solver s, const sp_step_data *data, const double *state,
                                 int kind_a, int kind_b, double *max_rel_diff) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl && data && state && max_rel_diff, "sp_solver_compare_jacobians: null argument");
     need(valid_kind(kind_a) && valid_kind(kind_b), "sp_solver_compare_jacobians: unknown kind");
@@ -170,7 +201,7 @@ int sp_solver_compare_jacobians(sp_solver s, const sp_step_data *data, const dou
 int sp_solver_time_jacobian(sp_solver s, const sp_step_data *data, const double *state,
                             int kind, int repeats, double *seconds_fill,
                             double *seconds_elements) {
-  if (!s) return SP_API_ERR + 1;
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl && data && state && seconds_fill, "sp_solver_time_jacobian: null argument");
     need(valid_kind(kind), "sp_solver_time_jacobian: unknown kind");

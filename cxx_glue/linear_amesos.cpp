@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "epetra_rows.hpp"
+#include "errors.hpp"
 #include "linear.hpp"
 
 namespace sp {
@@ -25,7 +26,7 @@ class AmesosSolver final : public DirectSolver {
   AmesosSolver(MPI_Comm comm, const std::string &which) : comm_(comm), which_(which) {
     Amesos factory;
     if (!factory.Query(which_))
-      throw std::runtime_error("solver.linear: " + which_ + " is not available in this Amesos build");
+      throw input_error("solver.linear: " + which_ + " is not available in this Amesos build");
   }
   ~AmesosSolver() override { release(); }
 

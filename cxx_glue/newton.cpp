@@ -23,6 +23,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "errors.hpp"
+
 namespace sp {
 namespace {
 
@@ -204,15 +206,15 @@ class RelativeDivergence : public ConditionTest {
 Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     : comm_(comm), options_(options) {
   if (options.jacobian < SP_SOLVER_JAC_AD || options.jacobian > SP_SOLVER_JAC_FD)
-    throw std::runtime_error("solver.jacobian: unknown kind");
+    throw input_error("solver.jacobian: unknown kind");
   if (!(options.jacobian_reuse >= 0 && options.jacobian_reuse < 1))
-    throw std::runtime_error("solver.jacobian_reuse: expected 0 <= value < 1");
+    throw input_error("solver.jacobian_reuse: expected 0 <= value < 1");
   if (options.ordering != SP_SOLVER_ORDER_PAIRS && options.ordering != SP_SOLVER_ORDER_UNKNOWNS)
-    throw std::runtime_error("solver.ordering: unknown kind");
+    throw input_error("solver.ordering: unknown kind");
   if (options.line_search != SP_SOLVER_STEP_FULL && options.line_search != SP_SOLVER_STEP_BACKTRACK)
-    throw std::runtime_error("solver.line_search: unknown kind");
+    throw input_error("solver.line_search: unknown kind");
   if (!(options.newton_divergence == 0 || options.newton_divergence > 1))
-    throw std::runtime_error("solver.newton_divergence: expected 0 (off) or a value > 1");
+    throw input_error("solver.newton_divergence: expected 0 (off) or a value > 1");
   const int P = comm_.NumProc();
   std::unique_ptr<DirectSolver> direct;
   switch (options.linear) {
@@ -231,7 +233,7 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
       // ranks (STACK.md, docs/parallel.md): one process only.
       if (P > 1)
-        throw std::runtime_error("solver.linear: klu2 runs on one MPI process only (this run has " +
+        throw input_error("solver.linear: klu2 runs on one MPI process only (this run has " +
                                  std::to_string(P) +
                                  "); use superlu_dist, mumps or klu with several processes");
       direct = make_amesos2_klu2(comm);
@@ -244,14 +246,14 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       if (k.fill < 0 || !(k.tolerance > 0 && k.tolerance < 1)) {
         char got[96];
         std::snprintf(got, sizeof got, "%d and %g", k.fill, k.tolerance);
-        throw std::runtime_error(
+        throw input_error(
             std::string("solver.ilu_fill / krylov_tol: expected fill >= 0 and 0 < tol < 1, got ") +
             got);
       }
       direct = make_krylov(comm, k);
       break;
     }
-    default: throw std::runtime_error("solver.linear: unknown kind");
+    default: throw input_error("solver.linear: unknown kind");
   }
   linear_ = std::make_unique<LowRankSolver>(comm, std::move(direct));
 }

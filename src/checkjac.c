@@ -14,6 +14,7 @@
 #include "mesh.h"
 #include "scene.h"
 #include "softpack_solver.h"
+#include "solver_status.h"
 #include "stepper.h"
 
 /** What the command holds. */
@@ -47,8 +48,8 @@ static int checkjac_setup(checkjac *c) {
   sp_solver_options opt;
   sp_solver_options_from_scene(scene, &opt);
   sp_model_from_scene(scene, &c->model);
-  if (sp_solver_create(MPI_COMM_WORLD, &opt, &c->solver) != 0)
-    return sp_error_set(SP_ERR_INPUT, "solver: %s", sp_solver_last_error(c->solver));
+  const int status = sp_solver_create(MPI_COMM_WORLD, &opt, &c->solver);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(c->solver, status, "solver");
   SP_CALL(sp_solver_attach(c->solver, c->mesh, c->layout));
   const size_t n_values = 2 * (size_t)c->layout->n_pairs;
   SP_ALLOC(c->state, n_values);
@@ -57,9 +58,8 @@ static int checkjac_setup(checkjac *c) {
 }
 
 static int compare(checkjac *c, const sp_step_data *data, int a, int b, double *out) {
-  if (sp_solver_compare_jacobians(c->solver, data, c->state, a, b, out) != 0)
-    return sp_error_set(SP_ERR_INTERNAL, "comparing Jacobians: %s",
-                        sp_solver_last_error(c->solver));
+  const int status = sp_solver_compare_jacobians(c->solver, data, c->state, a, b, out);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(c->solver, status, "comparing Jacobians");
   return SP_OK;
 }
 
@@ -106,9 +106,7 @@ static int take_steps(checkjac *c, int steps, double *t, double *dt_last, int *r
                          .source = NULL, .shape = NULL};
     sp_step_report report;
     int rc = sp_solver_step(c->solver, &data, c->state, &report);
-    if (rc > 1)
-      return sp_error_set(SP_ERR_SOLVER, "step %d: %s", step + 1,
-                          sp_solver_last_error(c->solver));
+    if (rc > SP_SOLVER_NOT_CONVERGED) return sp_solver_failed(c->solver, rc, "step %d", step + 1);
     if (rc == 1) {
       memcpy(c->state, c->state_old, n_values * sizeof(double));
       ++*retries;

@@ -13,15 +13,21 @@
 extern "C" {
 #endif
 
-/** Error codes; the values are the process exit statuses main uses. */
+/** Error codes (the classes of errors); sp_error_exit_status maps them to
+ *  process exit statuses: 2 for SP_ERR_INPUT only, 1 for every other. */
 typedef enum {
   SP_OK = 0,
-  SP_ERR_SOLVER = 1,  /**< a solve failed beyond the retries allowed */
-  SP_ERR_INPUT = 2,   /**< bad input: scene file, option, parameter */
+  SP_ERR_SOLVER = 1,  /**< a solve failed beyond the retries allowed, or a
+                           solver library failed (exit status 1) */
+  SP_ERR_INPUT = 2,   /**< bad input: scene file, option, parameter (exit 2) */
   SP_ERR_IO = 3,      /**< a file could not be written (exit status 1) */
   SP_ERR_MEMORY = 4,  /**< out of memory (exit status 1) */
-  SP_ERR_INTERNAL = 5 /**< a bug: an invariant did not hold (exit status 1) */
+  SP_ERR_INTERNAL = 5, /**< a bug: an invariant did not hold (exit status 1) */
+  SP_ERR_MPI = 6      /**< an MPI call failed (exit status 1) */
 } sp_error_code;
+
+/** The longest message kept (with its terminating 0). */
+#define SP_ERROR_MESSAGE_MAX 2048
 
 /** @brief Record an error message (printf format) and return @p code. */
 int sp_error_set(int code, const char *fmt, ...)
@@ -32,6 +38,17 @@ const char *sp_error_message(void);
 void sp_error_clear(void);
 /** @brief The process exit status for an error code (0, 1 or 2). */
 int sp_error_exit_status(int code);
+/** @brief The class of an error code in words ("bad input", "memory",
+ *         "solver", "output", "MPI", "internal"; "ok" for SP_OK). */
+const char *sp_error_class_name(int code);
+/** @brief Mark the recorded error as agreed by every rank of a run
+ *         (agree.h); @p adopted: 1 if it is another rank's error. Any later
+ *         sp_error_set or sp_error_clear unmarks it. */
+void sp_error_mark_agreed(int adopted);
+/** @brief 1 if the recorded error was agreed by every rank (agree.h). */
+int sp_error_agreed(void);
+/** @brief 1 if the recorded error is another rank's, learnt by agreement. */
+int sp_error_adopted(void);
 
 /** Return @p code with a message unless @p cond holds. */
 #define SP_CHECK(cond, code, ...)                                              \

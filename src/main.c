@@ -237,13 +237,23 @@ int main(int argc, char **argv) {
   }
   const int status = stopped ? SP_EXIT_STOPPED : sp_error_exit_status(rc);
   if (rc != SP_OK) {
-    /* One rank's failure ends all ranks, never a hang. Every failing rank
-     * prints its message: an error seen by rank > 0 alone is not lost. */
+    /* One rank's failure ends all ranks, never a hang. Rank 0 prints the
+     * error (its own or, agreed, the failing rank's), and every other rank
+     * that failed itself its own: an error seen by rank > 0 alone is not
+     * lost. The class is named unless it is bad input. */
     int size = 1;
     MPI_Comm_size(MPI_COMM_WORLD, &size);
-    if (rank == 0) fprintf(stderr, "softpack: error: %s\n", sp_error_message());
-    else fprintf(stderr, "softpack: error (rank %d of %d): %s\n", rank, size, sp_error_message());
-    if (size > 1) MPI_Abort(MPI_COMM_WORLD, status);
+    char what[64] = "";
+    if (rc != SP_ERR_INPUT) snprintf(what, sizeof what, "%s", sp_error_class_name(rc));
+    if (rank > 0)
+      snprintf(what + strlen(what), sizeof what - strlen(what), "%srank %d of %d",
+               what[0] ? ", " : "", rank, size);
+    if (rank == 0 || !sp_error_adopted())
+      fprintf(stderr, "softpack: error%s%s%s: %s\n", what[0] ? " (" : "", what,
+              what[0] ? ")" : "", sp_error_message());
+    /* an error the ranks agreed on ends each of them here; any other may
+     * leave ranks waiting in a collective: MPI_Abort ends them */
+    if (size > 1 && !sp_error_agreed()) MPI_Abort(MPI_COMM_WORLD, status);
   }
   MPI_Finalize();
   return status;

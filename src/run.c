@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "agree.h"
 #include "checkpoint.h"
 #include "initial.h"
 #include "scene.h"
@@ -12,6 +13,9 @@ static int run_loaded(int rc, sp_scene *scene, const sp_run_start *start, const 
                       sp_run_summary *summary) {
   sp_run_summary sum = {0};
   if (rc == SP_OK && !out_dir) rc = sp_error_set(SP_ERR_INPUT, "no output directory given");
+  /* every rank loaded the scene (and its checkpoint), or every rank
+   * returns the error */
+  rc = sp_agree(comm, rc);
   if (rc == SP_OK) rc = sp_stepper_run_from(scene, start, out_dir, comm, on_step, user, &sum);
   if (summary) *summary = sum;
   sp_scene_destroy(&scene);

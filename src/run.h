@@ -16,11 +16,16 @@
  *                          watch, NULL, &sum);
  *     if (rc != SP_OK) fprintf(stderr, "%s\n", sp_error_message());
  *
- * Every rank of @p comm calls it alike. Return codes are sp_error_code
- * (error.h): SP_ERR_INPUT for a bad scene or override (nothing written),
- * SP_ERR_SOLVER when a step failed beyond its retries (the last good state
- * is written), others for I/O, memory and internal errors; the message is
- * sp_error_message(). The callback (may be NULL) sees every accepted step
+ * Every rank of @p comm calls it alike, and every rank returns: a failure
+ * on any rank is an error on all of them (agree.h), never a hang. Return
+ * codes are sp_error_code (error.h): SP_ERR_INPUT for a bad scene or
+ * override (nothing written), SP_ERR_SOLVER when a step failed beyond its
+ * retries (the last good state is written) or a solver library failed,
+ * others for I/O, memory, MPI and internal errors; the message is
+ * sp_error_message() (on a rank that did not fail: "on rank R of P: "
+ * and the failing rank's message). The ranks agree over a duplicate of
+ * @p comm with MPI_ERRORS_RETURN; @p comm's own error handler is left as
+ * it is (with MPI's default, an MPI error inside the solver aborts). The callback (may be NULL) sees every accepted step
  * (stepper.h: sp_step_info, the cells' observables included) and stops the
  * run by returning non-zero (summary->stopped = 1, the state written as at
  * the end).

@@ -69,6 +69,8 @@ typedef struct {
   sp_run_summary *sum;
   sp_division_params division;
   MPI_Comm comm;
+  MPI_Comm agree_comm; /* errors are agreed on it before every collective
+                          (agree.h); MPI errors return codes there */
   sp_step_callback on_step; /* may be NULL */
   void *on_step_user;
   double t_start;           /* wall clock at the run's start */

@@ -8,11 +8,13 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "agree.h"
 #include "cells.h"
 #include "checkpoint.h"
 #include "division.h"
 #include "dt_control.h"
 #include "error.h"
+#include "fault.h"
 #include "initial.h"
 #include "layout.h"
 #include "output.h"
@@ -20,6 +22,7 @@
 #include "partition.h"
 #include "render.h"
 #include "shape.h"
+#include "solver_status.h"
 #include "source.h"
 #include "support.h"
 #include "time_scheme.h"
@@ -70,10 +73,9 @@ int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *lay
   sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
   sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
                        layout->pair_cell, first_node, n_ranks};
-  const int failed = sp_solver_set_problem(solver, &mv, &lv) != 0;
+  const int status = sp_solver_set_problem(solver, &mv, &lv);
   free(first_node);
-  if (failed)
-    return sp_error_set(SP_ERR_INTERNAL, "solver setup: %s", sp_solver_last_error(solver));
+  if (status != SP_SOLVER_OK) return sp_solver_failed(solver, status, "solver setup");
   return SP_OK;
 }
 
@@ -101,8 +103,9 @@ static void core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
 
 /** The energy parts of the fields (without the shape term) of the run's state. */
 static int state_energy(sp_run *run, sp_energy_parts *parts) {
-  if (sp_solver_energy(run->solver, &run->model, run->state, parts) != 0)
-    return sp_error_set(SP_ERR_INTERNAL, "energy: %s", sp_solver_last_error(run->solver));
+  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* a collective follows */
+  const int status = sp_solver_energy(run->solver, &run->model, run->state, parts);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "energy");
   return SP_OK;
 }
 
@@ -142,6 +145,7 @@ static int record_energy(sp_run *run, int step, double t, double dt, int its,
 }
 
 static int write_snapshot(sp_run *run, int step, double t) {
+  SP_CALL(sp_fault_check(SP_FAULT_OUTPUT, run->rank));
   if (run->n_ranks > 1) { /* a piece per rank, the .pvtu by rank 0 */
     int *first_node;
     SP_ALLOC(first_node, (size_t)run->n_ranks + 1);
@@ -222,6 +226,7 @@ static int adopt_layout(sp_run *run, sp_layout *layout, double *state, sp_histor
   run->layout = layout;
   run->state = state;
   SP_CALL(alloc_step_buffers(run));
+  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* a collective follows */
   return sp_solver_attach(run->solver, run->mesh, run->layout);
 }
 
@@ -475,38 +480,34 @@ void sp_run_request_stop(void) { stop_requested = 1; }
  *  alike; rank 0 writes. */
 static int checkpoint_if_due(sp_run *run, int *signalled) {
   const sp_scene_output *o = &run->scene->output;
-  int want[2] = {stop_requested != 0,
-                 o->checkpoint_seconds > 0 &&
-                     wall_clock() - run->t_checkpoint >= o->checkpoint_seconds};
-  if (run->n_ranks > 1) /* a signal may reach one rank; clocks differ */
-    MPI_Allreduce(MPI_IN_PLACE, want, 2, MPI_INT, MPI_MAX, run->comm);
-  *signalled = want[0];
-  if (!(want[0] || want[1] || (o->checkpoint_every > 0 && run->step % o->checkpoint_every == 0)))
+  /* a signal may reach one rank only, and the clocks differ: agreed */
+  int want_stop = stop_requested != 0;
+  int want_time = o->checkpoint_seconds > 0 &&
+                  wall_clock() - run->t_checkpoint >= o->checkpoint_seconds;
+  SP_CALL(sp_agree_any(run->agree_comm, &want_stop));
+  SP_CALL(sp_agree_any(run->agree_comm, &want_time));
+  *signalled = want_stop;
+  if (!(want_stop || want_time ||
+        (o->checkpoint_every > 0 && run->step % o->checkpoint_every == 0)))
     return SP_OK;
-  int rc = SP_OK;
   char path[4096] = "";
   const double t0 = wall_clock();
+  int rc = SP_OK;
   if (run->rank == 0) rc = sp_checkpoint_write(run, run->out_dir, path, sizeof path);
   run->sum->t_checkpoints += wall_clock() - t0;
   ++run->sum->checkpoints;
-  if (run->n_ranks > 1) { /* every rank learns whether it was written */
-    int failed = rc != SP_OK;
-    MPI_Bcast(&failed, 1, MPI_INT, 0, run->comm);
-    if (failed && run->rank != 0)
-      rc = sp_error_set(SP_ERR_IO, "rank 0 could not write a checkpoint (see its message)");
-  }
+  SP_CALL(sp_agree(run->agree_comm, rc)); /* every rank learns whether it was written */
   run->t_checkpoint = wall_clock();
   /* the next factorisation from scratch, as in a run continued from here
-   * (SuperLU_DIST's row permutation would otherwise come from an earlier
-   * matrix); sets a flag only */
-  if (rc == SP_OK && sp_solver_refactor_next(run->solver) != 0)
-    rc = sp_error_set(SP_ERR_INTERNAL, "solver: %s", sp_solver_last_error(run->solver));
-  if (rc == SP_OK && want[0] && run->rank == 0) {
+   * (sets a flag only) */
+  const int status = sp_solver_refactor_next(run->solver);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "solver");
+  if (want_stop && run->rank == 0) {
     if (isatty(fileno(stderr))) fputs("\r\033[K", stderr);
     fprintf(stderr, "softpack: stopped on a signal after step %d (t = %.6g): checkpoint %s\n",
             run->step, run->t, path);
   }
-  return rc;
+  return SP_OK;
 }
 
 /** The time loop proper. */
@@ -553,6 +554,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
         run->state[i] = run->state_old[i] + r * (run->state_old[i] - prev[i]);
     }
     rc = explicit_terms(run, &shape_coef);
+    if (rc == SP_OK) rc = sp_fault_check(SP_FAULT_STEP, run->rank);
+    rc = sp_agree(run->agree_comm, rc); /* Newton's collectives follow */
     if (rc != SP_OK) break;
     const sp_scheme_kind kind = sp_scheme_of_step(scheme, &run->hist);
     double dt_eff = dt_try;
@@ -574,9 +577,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     seconds.assembly += report.t_assembly;
     seconds.factorisation += report.t_factor;
     seconds.solves += report.t_solve;
-    if (solved > 1) {
-      rc = sp_error_set(SP_ERR_SOLVER, "step %d at t = %g: %s", step + 1, t,
-                        sp_solver_last_error(run->solver));
+    if (solved > SP_SOLVER_NOT_CONVERGED) {
+      rc = sp_solver_failed(run->solver, solved, "step %d at t = %g", step + 1, t);
       break;
     }
     double err = -1.0;
@@ -665,9 +667,11 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     int n_divided = 0, have_energy = 0;
     sp_energy_parts energy_after_supports;
     if (rc == SP_OK) rc = divide_due_cells(run, t_old, t, step, core_mass_old, &n_divided);
+    int outgrown = 0; /* a cell reaches its support's edge */
+    if (rc == SP_OK && run->support && !n_divided)
+      rc = sp_support_needs_update(run->support, run->layout, run->state, &outgrown);
     if (rc != SP_OK) break;
-    if (rc == SP_OK && run->support &&
-        (n_divided || sp_support_needs_update(run->support, run->layout, run->state))) {
+    if (run->support && (n_divided || outgrown)) {
       const double t_layout = run->sum->t_layout;
       rc = update_supports(run, &energy_after_supports);
       have_energy = rc == SP_OK;
@@ -710,13 +714,14 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                                  .wall_seconds = wall_clock() - run->t_start,
                                  .last = ends};
       stop = run->on_step(&info, run->on_step_user) != 0;
-      if (run->n_ranks > 1) /* any rank's stop stops every rank */
-        MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, run->comm);
+      rc = sp_agree_any(run->agree_comm, &stop); /* any rank's stop stops every rank */
+      if (rc != SP_OK) break;
       sum->stopped = stop ? SP_STOPPED_CALLBACK : 0;
     }
     if (step % run->scene->output.every == 0 || ends || stop || n_divided ||
         (lands && on_output_time(run->scene, t)))
       rc = write_snapshot(run, step, t);
+    rc = sp_agree(run->agree_comm, rc); /* the output's errors, before collectives */
     if (rc == SP_OK && !ends) { /* checkpoints: due, or a signal asked for one */
       int signalled = 0;
       rc = checkpoint_if_due(run, &signalled);
@@ -735,6 +740,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
 }
 
 static void run_free(sp_run *run) {
+  sp_agree_comm_free(&run->agree_comm);
   sp_output_close(&run->output);
   sp_solver_destroy(&run->solver);
   sp_layout_destroy(&run->layout);
@@ -807,8 +813,8 @@ static int new_registry(sp_run *run) {
 
 static int run_setup(sp_run *run, MPI_Comm comm, const sp_run_start *start) {
   const sp_scene *scene = run->scene;
-  MPI_Comm_rank(comm, &run->rank);
-  MPI_Comm_size(comm, &run->n_ranks);
+  SP_MPI_CALL(MPI_Comm_rank(run->agree_comm, &run->rank));
+  SP_MPI_CALL(MPI_Comm_size(run->agree_comm, &run->n_ranks));
   SP_CALL(sp_mesh_from_scene(scene, &run->mesh));
   /* The initial cells: the scene's disks or a file's (initial.h). A
    * checkpoint's replace them below; a scene without cells (initial.from a
@@ -817,11 +823,13 @@ static int run_setup(sp_run *run, MPI_Comm comm, const sp_run_start *start) {
   int n = 1;
   if (!placeholder) SP_CALL(sp_initial_cell_count(scene, &n));
   SP_CALL(sp_layout_create_full(run->mesh->n_nodes, n, &run->layout));
+  SP_CALL(sp_fault_check(SP_FAULT_SETUP, run->rank));
   sp_solver_options opt;
   sp_solver_options_from_scene(scene, &opt);
   sp_model_from_scene(scene, &run->model);
-  if (sp_solver_create(comm, &opt, &run->solver) != 0)
-    return sp_error_set(SP_ERR_INPUT, "solver: %s", sp_solver_last_error(run->solver));
+  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* creating the solver is collective */
+  const int status = sp_solver_create(comm, &opt, &run->solver);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "solver");
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
   SP_ALLOC(run->state, n_values);
   SP_CALL(alloc_step_buffers(run));
@@ -864,6 +872,7 @@ static int run_setup(sp_run *run, MPI_Comm comm, const sp_run_start *start) {
     SP_CALL(rc);
     run->restarted = !start->as_initial;
     SP_CALL(alloc_step_buffers(run));
+    SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* attaching is collective */
     SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
     if (start->as_initial) { /* observes too */
       SP_CALL(new_registry(run));
@@ -889,6 +898,7 @@ static int run_setup(sp_run *run, MPI_Comm comm, const sp_run_start *start) {
     SP_CALL(adopt_layout(run, layout, state, SP_HISTORY_RESET));
     SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold, run->obs));
   } else {
+    SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* attaching is collective */
     SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   }
   /* (With local supports the solver sees only the local layout: the full
@@ -918,7 +928,8 @@ int sp_stepper_run_from(const sp_scene *scene, const sp_run_start *start, const 
   sp_run_summary sum = {0};
   const double t0 = wall_clock();
   sp_run run = {.scene = scene, .sum = &sum, .out_dir = out_dir, .comm = comm,
-                .on_step = on_step, .on_step_user = user, .t_start = t0, .t_checkpoint = t0};
+                .agree_comm = MPI_COMM_NULL, .on_step = on_step, .on_step_user = user,
+                .t_start = t0, .t_checkpoint = t0};
   if (start) {
     run.scene_text = start->scene_text;
     run.scene_len = start->scene_len;
@@ -926,25 +937,25 @@ int sp_stepper_run_from(const sp_scene *scene, const sp_run_start *start, const 
     run.set = start->set;
   }
   stop_requested = 0;
-  int rc = run_setup(&run, comm, start);
-  /* Only now, with the input known good, does anything get written. */
-  if (rc == SP_OK && run.rank == 0) {
-    if (run.restarted) { /* the logs cut back to the checkpoint's step */
-      sp_checkpoint_remove_after(out_dir, run.step);
-      rc = sp_output_resume(out_dir, run.step, run.n_fields, run.fields, &run.output);
-    } else {
-      rc = sp_output_open(out_dir, &run.output);
+  int rc = sp_agree_comm_create(comm, &run.agree_comm);
+  if (rc == SP_OK) {
+    rc = sp_agree(run.agree_comm, run_setup(&run, comm, start));
+    /* Only now, with the input known good on every rank, does anything
+     * get written (the other ranks write pieces into rank 0's directory). */
+    if (rc == SP_OK && run.rank == 0) {
+      if (run.restarted) { /* the logs cut back to the checkpoint's step */
+        sp_checkpoint_remove_after(out_dir, run.step);
+        rc = sp_output_resume(out_dir, run.step, run.n_fields, run.fields, &run.output);
+      } else {
+        rc = sp_output_open(out_dir, &run.output);
+      }
     }
+    free(run.fields);
+    run.fields = NULL;
+    if (rc == SP_OK) rc = run_steps(&run, &sum);
+    /* A rank that failed alone meets here the other ranks' next agreement. */
+    rc = sp_agree(run.agree_comm, rc);
   }
-  free(run.fields);
-  run.fields = NULL;
-  if (run.n_ranks > 1) { /* the other ranks write pieces into rank 0's directory */
-    int failed = rc != SP_OK, any_failed = 0;
-    MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, comm);
-    if (any_failed && !failed)
-      rc = sp_error_set(SP_ERR_IO, "another rank failed before the run began (see its message)");
-  }
-  if (rc == SP_OK) rc = run_steps(&run, &sum);
   sum.wall_seconds = wall_clock() - t0;
   if (summary) *summary = sum;
   run_free(&run);

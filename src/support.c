@@ -159,10 +159,13 @@ static int on_edge(sp_support s, const sp_layout *layout, int k, int i) {
   return 0;
 }
 
-int sp_support_needs_update(sp_support s, const sp_layout *layout, const double *state) {
+int sp_support_needs_update(sp_support s, const sp_layout *layout, const double *state,
+                            int *needed) {
   const int nn = s->mesh->n_nodes;
-  unsigned char *allowed = calloc(nn, 1);
-  if (!allowed) return 1; /* rebuilding is always safe */
+  *needed = 0;
+  unsigned char *allowed;
+  /* (a failure is an error, not "rebuild": every rank must decide alike) */
+  SP_ALLOC(allowed, (size_t)nn);
   int grow = 0;
   for (int k = 0; k < layout->n_cells && !grow; ++k) {
     int n_seeds = 0;
@@ -178,7 +181,8 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout, const double 
     clear_set(s, reached);
   }
   free(allowed);
-  return grow;
+  *needed = grow;
+  return SP_OK;
 }
 
 /** The fraction of the elements around node i that are buffer ring. */

@@ -49,10 +49,15 @@ int sp_support_create(const sp_mesh *mesh, const sp_support_params *params,
 int sp_support_masks(sp_support s, const sp_layout *layout,
                      const double *state, unsigned char *mask);
 
-/** @brief 1 if some cell's c_k >= grow_threshold within the band of its
- *         support's edge (the domain boundary is not an edge), else 0. */
+/**
+ * @brief Whether some cell's c_k >= grow_threshold within the band of its
+ *        support's edge (the domain boundary is not an edge).
+ * @param[out] needed 1 if so, else 0
+ * @return SP_OK or SP_ERR_MEMORY (never "rebuild" on one rank alone: the
+ *         answer feeds collectives, so every rank must give the same)
+ */
 int sp_support_needs_update(sp_support s, const sp_layout *layout,
-                            const double *state);
+                            const double *state, int *needed);
 
 /**
  * @brief New supports from the fields, values moved to them, masses

@@ -16,6 +16,22 @@
  *     klu, klu2) on MPI_COMM_WORLD against serial SuperLU on MPI_COMM_SELF:
  *     max |x_k - x_k,ref| <= 1e-10 max |x_k,ref| for k = 1..4.
  *
+ *   mpi_compare library SCENE [section.key=value]...
+ *     The library under faults (src/fault.h): with SOFTPACK_FAULT set on
+ *     every rank to a fault on one rank (at set-up, in the solver's
+ *     creation, in a step, at output; rank 1, and rank 0 for some),
+ *     sp_run_file returns on every rank with the fault's class
+ *     (memory, solver, output) and a message naming it; then a run without
+ *     a fault succeeds on every rank (the library is usable after them),
+ *     stopped after step 2 on every rank by a callback that stops on rank 1.
+ *
+ *   mpi_compare faults         (run without mpirun)
+ *     The real program under `mpirun -np 2` with a fault on rank 1 at
+ *     set-up, in the solver's creation, in a step and at output: every run
+ *     ends within seconds (timeout -s KILL 60 makes a hang fail), exit
+ *     status 1, the message on stderr; and rank 1 killed by SIGKILL in a
+ *     step ends the run (mpirun tears the job down), not a hang.
+ *
  *   mpi_compare cli            (run without mpirun)
  *     The real program under `mpirun -np 2`: a bad scene, klu2 (refused on
  *     several processes) and an unwritable output directory each end within
@@ -31,6 +47,7 @@
 #include "fixtures.h"
 #include "scene.h"
 #include "output_read.h"
+#include "run.h"
 
 static double rel(double a, double b) {
   double s = fmax(fabs(a), fabs(b));
@@ -307,6 +324,49 @@ static int cmd_iterates(int argc, char **argv, int rank, int size) {
   return 0;
 }
 
+/* ---------- library: faults on one rank, every rank returns ---------- */
+
+/** A step callback that stops the run after step 2 on rank 1 only. */
+static int stop_on_rank_1(const sp_step_info *s, void *user) {
+  return *(const int *)user == 1 && s->step >= 2;
+}
+
+static int cmd_library(int argc, char **argv, int rank) {
+  if (argc < 1) {
+    fprintf(stderr, "usage: mpi_compare library SCENE [key=value]...\n");
+    return 2;
+  }
+  const char *const *set = (const char *const *)argv + 1;
+  static const struct {
+    const char *fault;
+    int code;
+  } cases[] = {{"setup:1", SP_ERR_MEMORY}, {"solver:1", SP_ERR_SOLVER},
+               {"step:1", SP_ERR_MEMORY},  {"output:1", SP_ERR_IO},
+               {"step:0", SP_ERR_MEMORY},  {"output:0", SP_ERR_IO}};
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    setenv("SOFTPACK_FAULT", cases[i].fault, 1);
+    const double t0 = MPI_Wtime();
+    const int rc = sp_run_file(argv[0], argc - 1, set, "mpi_library_out", MPI_COMM_WORLD, NULL,
+                               NULL, NULL);
+    unsetenv("SOFTPACK_FAULT");
+    char needle[64];
+    snprintf(needle, sizeof needle, "SOFTPACK_FAULT=%s", cases[i].fault);
+    printf("rank %d, %s: code %d after %.1f s: %s\n", rank, cases[i].fault, rc,
+           MPI_Wtime() - t0, sp_error_message());
+    CHECK(rc == cases[i].code, "rank %d, %s: code %d, want %d", rank, cases[i].fault, rc,
+          cases[i].code);
+    CHECK(strstr(sp_error_message(), needle) != NULL, "rank %d, %s: message %s", rank,
+          cases[i].fault, sp_error_message());
+  }
+  sp_run_summary sum = {0};
+  CHECK_OK(sp_run_file(argv[0], argc - 1, set, "mpi_library_out", MPI_COMM_WORLD,
+                       stop_on_rank_1, &rank, &sum));
+  CHECK(sum.stopped == 1 && sum.steps == 2,
+        "rank %d: rank 1's stop after step 2: stopped %d after %d steps", rank, sum.stopped,
+        sum.steps);
+  return 0;
+}
+
 /* ---------- cli: the real program under mpirun ---------- */
 
 static int run_mpi(int np, const char *args, char *out, size_t size, double *seconds) {
@@ -374,8 +434,44 @@ static int cmd_cli(void) {
   TEST_DONE();
 }
 
+/* ---------- faults: the real program with a fault on one rank ---------- */
+
+static int cmd_faults(void) {
+  char args[4096];
+  snprintf(args, sizeof args,
+           "run %s/tests/scenes/divide_1_2_4.yaml --out mpi_faults_out --set output.pictures=false "
+           "--set layout.support=local --set time.max_steps=4",
+           SP_SOURCE_DIR);
+  /* the class, the failing rank and the phase named (not the wording) */
+  static const char *const faults[][4] = {
+      {"setup:1", "(memory)", "rank 1 of 2", "setup"},
+      {"solver:1", "(solver)", "rank 1", "solver"},
+      {"step:1", "(memory)", "rank 1 of 2", "step"},
+      {"output:1", "(output)", "rank 1 of 2", "fields"}};
+  for (size_t i = 0; i < sizeof faults / sizeof faults[0]; ++i) {
+    char what[64];
+    snprintf(what, sizeof what, "SOFTPACK_FAULT=%s, np 2", faults[i][0]);
+    setenv("SOFTPACK_FAULT", faults[i][0], 1);
+    const char *const names[] = {faults[i][1], faults[i][2], faults[i][3], NULL};
+    expect_failure(what, args, 1, names);
+  }
+  /* a rank killed: mpirun ends the job (its status is the signal's) */
+  setenv("SOFTPACK_FAULT", "step:1:kill", 1);
+  char out[16384];
+  double seconds = 0;
+  const int status = run_mpi(2, args, out, sizeof out, &seconds);
+  unsetenv("SOFTPACK_FAULT");
+  printf("rank 1 killed in a step: exit status %d after %.1f s\n", status, seconds);
+  CHECK(status != 0 && seconds < 50, "rank 1 killed: exit status %d after %.1f s:\n%s", status,
+        seconds, out);
+  CHECK(strstr(out, "Killed") != NULL, "rank 1 killed: mpirun does not say so:\n%s", out);
+  TEST_DONE();
+}
+
 int main(int argc, char **argv) {
-  if (argc >= 2 && strcmp(argv[1], "cli") == 0) return cmd_cli(); /* no MPI_Init: it runs mpirun */
+  /* no MPI_Init for these: they run mpirun */
+  if (argc >= 2 && strcmp(argv[1], "cli") == 0) return cmd_cli();
+  if (argc >= 2 && strcmp(argv[1], "faults") == 0) return cmd_faults();
   MPI_Init(&argc, &argv);
   int rank, size;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -383,7 +479,8 @@ int main(int argc, char **argv) {
   int rc = 2;
   if (argc >= 2 && strcmp(argv[1], "steps") == 0) rc = cmd_steps(argc - 2, argv + 2, rank, size);
   else if (argc >= 2 && strcmp(argv[1], "iterates") == 0) rc = cmd_iterates(argc - 2, argv + 2, rank, size);
-  else if (rank == 0) fprintf(stderr, "usage: mpi_compare steps|iterates|cli ...\n");
+  else if (argc >= 2 && strcmp(argv[1], "library") == 0) rc = cmd_library(argc - 2, argv + 2, rank);
+  else if (rank == 0) fprintf(stderr, "usage: mpi_compare steps|iterates|library|faults|cli ...\n");
   /* Every rank's failures count (the comparisons are made on rank 0). */
   int failures = sp_test_failures + (rc != 0), total = 0;
   MPI_Allreduce(&failures, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);

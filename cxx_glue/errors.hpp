@@ -1,0 +1,37 @@
+// The classes of hard errors the glue reports through the C door
+// (sp_solver_status in c_api/softpack_solver.h). c_api.cpp maps each
+// exception to its class: input_error -> SP_SOLVER_ERR_INPUT,
+// std::bad_alloc -> MEMORY, mpi_error -> MPI, any other std::logic_error
+// (an invariant or argument check: a bug) -> INTERNAL, everything else
+// (std::runtime_error from a library, NOX's const char*) -> SOLVER.
+#pragma once
+
+#include <mpi.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace sp {
+
+// Options or a choice the user made that the glue refuses (the message
+// names the scene key): bad input, exit status 2.
+struct input_error : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+// An MPI call that returned an error code.
+struct mpi_error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Throw mpi_error unless an MPI call returned MPI_SUCCESS (codes come back
+// only on communicators with MPI_ERRORS_RETURN; by default MPI aborts).
+inline void check_mpi(int code, const char *call) {
+  if (code == MPI_SUCCESS) return;
+  char text[MPI_MAX_ERROR_STRING] = "";
+  int len = 0;
+  MPI_Error_string(code, text, &len);
+  throw mpi_error(std::string("MPI: ") + call + " failed: " + text);
+}
+
+}  // namespace sp
