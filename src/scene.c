@@ -43,6 +43,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "error.h"
 #include "layout.h"
@@ -1273,6 +1274,17 @@ static int check_initial(const sp_scene *scene, const char *file) {
   SP_CHECK(scene->n_cells == 0 || !(from || image), SP_ERR_INPUT,
            "%s: cells: expected none with initial.%s (the file gives the cells), got %d",
            file, from ? "from" : "label_image", scene->n_cells);
+  if (from) {
+    const size_t n = strlen(in->from);
+    SP_CHECK((n > 3 && strcmp(in->from + n - 3, ".h5") == 0) ||
+                 (n > 4 && strcmp(in->from + n - 4, ".vtu") == 0),
+             SP_ERR_INPUT, "%s: initial.from: expected a softpack checkpoint (.h5) or .vtu, got '%s'",
+             file, in->from);
+  }
+  const char *source = from ? in->from : image ? in->label_image : NULL;
+  SP_CHECK(!source || access(source, R_OK) == 0, SP_ERR_INPUT,
+           "%s: initial.%s: cannot read '%s': %s", file, from ? "from" : "label_image", source,
+           strerror(errno));
   SP_CHECK(!image || in->x1 > in->x0, SP_ERR_INPUT,
            "%s: initial.x1: expected a number > initial.x0 = %.15g, got %.15g", file,
            in->x0, in->x1);

@@ -32,6 +32,35 @@ static const struct {
 } disks[3] = {{0.05, 0.08, 0.07, 0x00ff00}, {-0.25, 0.0, 0.08, 0xff0000},
               {0.28, -0.05, 0.09, 0x0000ff}};
 
+/** A scene's initial fields on the full layout of its mesh, and the
+ *  cells' observables (threshold @p threshold): what the files say. */
+typedef struct {
+  int n;
+  sp_mesh *mesh;
+  sp_layout *layout;
+  double *state;
+  sp_cell_obs *obs;
+} initial_fields;
+
+static initial_fields initial_of(const sp_scene *scene, double threshold) {
+  initial_fields f;
+  CHECK_OK(sp_initial_cell_count(scene, &f.n));
+  CHECK_OK(sp_mesh_from_scene(scene, &f.mesh));
+  CHECK_OK(sp_layout_create_full(f.mesh->n_nodes, f.n, &f.layout));
+  f.state = calloc(2 * (size_t)f.layout->n_pairs, sizeof(double));
+  CHECK_OK(sp_initial_state(scene, f.mesh, f.layout, f.state));
+  f.obs = calloc(f.n, sizeof *f.obs);
+  CHECK_OK(sp_cells_observe(f.mesh, f.layout, f.state, threshold, f.obs));
+  return f;
+}
+
+static void initial_free(initial_fields *f) {
+  free(f->obs);
+  free(f->state);
+  sp_layout_destroy(&f->layout);
+  sp_mesh_destroy(&f->mesh);
+}
+
 static void label_image(void) {
   const double px = (box[2] - box[0]) / W;
   cairo_surface_t *img = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
@@ -71,17 +100,10 @@ static void label_image(void) {
                      "initial: {label_image: labels.png}\n";
   sp_scene *scene;
   CHECK_OK(sp_scene_load_text("labels", text, strlen(text), 0, NULL, &scene));
-  int n;
-  CHECK_OK(sp_initial_cell_count(scene, &n));
+  initial_fields f = initial_of(scene, 0.0);
+  int n = f.n;
   CHECK(n == 3, "%d cells found, the image has 3 labels", n);
-  sp_mesh *mesh;
-  CHECK_OK(sp_mesh_from_scene(scene, &mesh));
-  sp_layout *layout;
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, n, &layout));
-  double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
-  CHECK_OK(sp_initial_state(scene, mesh, layout, state));
-  sp_cell_obs obs[3];
-  CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, obs));
+  const sp_cell_obs *obs = f.obs;
   const double d = sp_scene_interface_width(scene);
   const double excess = M_PI * M_PI * M_PI * d * d / 3;
   for (int k = 0; k < 3; ++k) {
@@ -94,17 +116,23 @@ static void label_image(void) {
     CHECK(hypot(obs[k].xc - sx[k] / area[k], obs[k].yc - sy[k] / area[k]) < 0.5 * px,
           "cell %d: centre off the image's by more than half a pixel", k + 1);
   }
-  /* a missing image: bad input naming the key */
+  /* a missing image: bad input naming the key, when the scene is read */
   const char *missing = "mesh: {type: rectangle}\ninitial: {label_image: no_such.png}\n";
-  sp_scene *bad;
-  CHECK_OK(sp_scene_load_text("missing", missing, strlen(missing), 0, NULL, &bad));
+  sp_scene *bad = NULL;
+  CHECK(sp_scene_load_text("missing", missing, strlen(missing), 0, NULL, &bad) == SP_ERR_INPUT &&
+            !bad && strstr(sp_error_message(), "initial.label_image"),
+        "missing image: %s", sp_error_message());
+  /* an image that is not a PNG: bad input naming the key, at set-up */
+  FILE *junk = fopen("not_a.png", "w");
+  fputs("not a png\n", junk);
+  fclose(junk);
+  const char *not_png = "mesh: {type: rectangle}\ninitial: {label_image: not_a.png}\n";
+  CHECK_OK(sp_scene_load_text("not_png", not_png, strlen(not_png), 0, NULL, &bad));
   CHECK(sp_initial_cell_count(bad, &n) == SP_ERR_INPUT &&
-            strstr(sp_error_message(), "initial.label_image"), "missing image: %s",
+            strstr(sp_error_message(), "initial.label_image"), "not a PNG: %s",
         sp_error_message());
   sp_scene_destroy(&bad);
-  free(state);
-  sp_layout_destroy(&layout);
-  sp_mesh_destroy(&mesh);
+  initial_free(&f);
   sp_scene_destroy(&scene);
 }
 
@@ -128,19 +156,12 @@ static void vtu_start(void) {
                      "output: {pictures: false}\n";
   const char *set2[] = {set_from};
   CHECK_OK(sp_scene_load_text("from_vtu", text, strlen(text), 1, set2, &scene));
-  int n;
-  CHECK_OK(sp_initial_cell_count(scene, &n));
   csv_table cells, energy;
   CHECK(csv_read("initial_vtu_a/cells.csv", &cells) == 0, "cells.csv");
   CHECK(csv_read("initial_vtu_a/energy.csv", &energy) == 0, "energy.csv");
-  sp_mesh *mesh;
-  CHECK_OK(sp_mesh_from_scene(scene, &mesh));
-  sp_layout *layout;
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, n, &layout));
-  double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
-  CHECK_OK(sp_initial_state(scene, mesh, layout, state));
-  sp_cell_obs *obs = calloc(n, sizeof *obs);
-  CHECK_OK(sp_cells_observe(mesh, layout, state, scene->division.observe_threshold, obs));
+  initial_fields f = initial_of(scene, scene->division.observe_threshold);
+  const int n = f.n;
+  const sp_cell_obs *obs = f.obs;
   int matched = 0;
   for (int i = 0; i < cells.n_rows; ++i) {
     if ((int)at(&cells, i, "step") != step) continue;
@@ -166,13 +187,10 @@ static void vtu_start(void) {
          at(&e2, 0, "energy"), step, e_then);
   CHECK(fabs(at(&e2, 0, "energy") / e_then - 1) < 1e-12, "energy %.17g, written from %.17g",
         at(&e2, 0, "energy"), e_then);
-  free(obs);
-  free(state);
+  initial_free(&f);
   free(cells.v);
   free(energy.v);
   free(e2.v);
-  sp_layout_destroy(&layout);
-  sp_mesh_destroy(&mesh);
   sp_scene_destroy(&scene);
 }
 
