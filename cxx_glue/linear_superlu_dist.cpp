@@ -11,9 +11,9 @@
 // permutation and scalings (MC64) of each matrix anew, so a factorisation
 // depends on its matrix alone, not on the matrices before it: a run
 // continued from a checkpoint factorises exactly as the run that wrote it.
-// SamePattern_SameRowPerm (the first matrix's row permutation kept) was
-// faster by 5-30% of the factorisation time: the price of bit-identical
-// continuation, measured in docs/restart.md. Factorisation (nrhs = 0) and
+// SamePattern_SameRowPerm (the first matrix's row permutation kept) spent
+// 21-26% less time factorising: the price of bit-identical continuation,
+// measured in docs/restart.md. Factorisation (nrhs = 0) and
 // solves (Fact = FACTORED) are separate calls, so they are timed separately.
 //
 // superlu_ddefs.h clashes with SuperLU's slu_ddefs.h: keep it alone in this TU.
@@ -78,17 +78,14 @@ class SuperLUDist final : public DirectSolver {
       ++symbolic_;
     } else {
       options_.Fact = SamePattern;
-      // The solve set-up is for solve_nrhs_ columns: for another count,
-      // drop it (with the refinement's), the next solve rebuilds it on the
-      // fresh matrix below.
-      if (options_.SolveInitialized == YES && next_nrhs_ != solve_nrhs_)
-        dSolveFinalize(&options_, &solve_);
-      // The refinement's matrix-vector pattern was built on the previous
-      // (renumbered) matrix: drop it, the next solve rebuilds it.
-      if (options_.SolveInitialized == YES && options_.RefineInitialized == YES) {
-        pdgsmv_finalize(solve_.gsmv_comm);
-        options_.RefineInitialized = NO;
-      }
+      // SamePattern computes the factors' structure anew (the row
+      // permutation may differ): the old L and U are freed first, as
+      // pdgssvx expects (kept, they leaked one factorisation's memory per
+      // Newton iteration: 24 GB on the aggregate), and the solve set-up,
+      // built on them, is dropped with the refinement's; the next solve
+      // rebuilds both on the fresh matrix below.
+      if (options_.SolveInitialized == YES) dSolveFinalize(&options_, &solve_);
+      if (have_lu_) dDestroy_LU(n_, &grid_, &lu_);
     }
     // Fresh copies of what pdgssvx overwrote last time.
     const int nnz = A.row_ptr[A.n_rows];
