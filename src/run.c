@@ -43,8 +43,10 @@ static int safe_to_change(const char *key) {
          strcmp(key, "time.max_steps") == 0 || strncmp(key, "initial.", 8) == 0;
 }
 
-/** Open the checkpoint @p restart names and check @p scene against its. */
-static int open_checkpoint(const sp_restart *restart, const sp_scene *scene, sp_checkpoint *ck) {
+/** Open the checkpoint @p restart names and check @p scene (read from
+ *  @p scene_path) against its. */
+static int open_checkpoint(const sp_restart *restart, const char *scene_path,
+                           const sp_scene *scene, sp_checkpoint *ck) {
   char found[4096];
   const char *path = restart->checkpoint;
   if (!path) {
@@ -57,8 +59,8 @@ static int open_checkpoint(const sp_restart *restart, const sp_scene *scene, sp_
   int n_set;
   const char *const *set;
   const char *text = sp_checkpoint_scene(*ck, &len, &n_set, &set);
-  sp_scene *saved = NULL;
-  int rc = sp_scene_load_text(path, text, len, n_set, set, &saved);
+  sp_scene *saved = NULL; /* its file names as from the scene file's directory */
+  int rc = sp_scene_load_text(scene_path, text, len, n_set, set, &saved);
   if (rc != SP_OK) {
     rc = sp_error_set(SP_ERR_INPUT, "checkpoint '%s': its scene does not load with this "
                                     "softpack (%s)", path, sp_error_message());
@@ -87,7 +89,7 @@ int sp_run_file_restart(const char *path, int n_set, const char *const *set,
   sp_checkpoint ck = NULL;
   int as_initial = restart && restart->as_initial;
   if (rc == SP_OK && restart && (restart->checkpoint || restart->resume_dir)) {
-    rc = open_checkpoint(restart, scene, &ck);
+    rc = open_checkpoint(restart, path, scene, &ck);
   } else if (rc == SP_OK && sp_initial_from_checkpoint(scene)) { /* initial.from: FILE.h5 */
     rc = sp_checkpoint_open(scene->initial.from, &ck);
     if (rc != SP_OK) rc = sp_error_set(rc, "initial.from: %s", sp_error_message());
