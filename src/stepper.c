@@ -198,6 +198,14 @@ static int alloc_step_buffers(sp_run *run) {
   return SP_OK;
 }
 
+/** What follows every new layout of the run (adopt_layout's, a
+ *  checkpoint's): the per-pair buffers resized, the solver given it. */
+static int layout_taken(sp_run *run) {
+  SP_CALL(alloc_step_buffers(run));
+  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* attaching is collective */
+  return sp_solver_attach(run->solver, run->mesh, run->layout);
+}
+
 /** What a layout change does to the time scheme's history. */
 typedef enum {
   SP_HISTORY_CARRY, /**< a support change: the past states move with (cell,
@@ -225,9 +233,7 @@ static int adopt_layout(sp_run *run, sp_layout *layout, double *state, sp_histor
   free(run->state);
   run->layout = layout;
   run->state = state;
-  SP_CALL(alloc_step_buffers(run));
-  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* a collective follows */
-  return sp_solver_attach(run->solver, run->mesh, run->layout);
+  return layout_taken(run);
 }
 
 /** Local supports: recompute every support from the fields (they follow
@@ -871,9 +877,7 @@ static int run_setup(sp_run *run, MPI_Comm comm, const sp_run_start *start) {
     }
     SP_CALL(rc);
     run->restarted = !start->as_initial;
-    SP_CALL(alloc_step_buffers(run));
-    SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* attaching is collective */
-    SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
+    SP_CALL(layout_taken(run)); /* the checkpoint's layout, history with it */
     if (start->as_initial) { /* observes too */
       SP_CALL(new_registry(run));
       reference_mass = run->birth[0].birth_mass;
