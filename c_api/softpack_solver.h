@@ -160,9 +160,20 @@ typedef struct {
                                    state's moments through gain */
 } sp_step_data;
 
+/** Why a Newton solve failed (sp_step_report.failure). */
+typedef enum {
+  SP_NEWTON_CONVERGED = 0,
+  SP_NEWTON_MAX_ITERATIONS, /**< solver.newton_max_its reached */
+  SP_NEWTON_DIVERGED,       /**< |F| above solver.newton_divergence x the first */
+  SP_NEWTON_NOT_FINITE,     /**< a residual norm was not finite */
+  SP_NEWTON_LINEAR_FAILED,  /**< a linear solve failed (reason says how) */
+  SP_NEWTON_OTHER_FAILURE   /**< NOX stopped for another reason */
+} sp_newton_failure;
+
 /** What a step did. */
 typedef struct {
   int converged;        /**< 1 only if Newton met its tolerance */
+  int failure;          /**< sp_newton_failure: why not (0 when converged) */
   int newton_its;
   int factorisations;   /**< Jacobians filled and factored (<= newton_its) */
   long linear_its;      /**< iterative solver (gmres_ilu): its GMRES iterations

@@ -521,19 +521,25 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   const double last = report.n_residuals ? report.residual_norms[report.n_residuals - 1] : NAN;
   char ratio[32];
   snprintf(ratio, sizeof ratio, "%g", options_.newton_divergence);
-  std::string why = !last_error.empty() ? last_error
-                    : !std::isfinite(last) ? "the residual is not finite"
-                    : !diverged.is_null() && diverged->getStatus() == Failed
-                        ? "diverged: |F| above " + std::string(ratio) +
-                              " x the first |F| after " + std::to_string(report.newton_its) +
-                              " Newton iterations (" + std::to_string(report.factorisations) +
-                              " factorisations)"
-                    : report.newton_its >= max_its ||
-                              report.factorisations >= options_.newton_max_its
-                        ? "no convergence in " + std::to_string(report.newton_its) +
-                              " Newton iterations (" + std::to_string(report.factorisations) +
-                              " factorisations)"
-                        : "Newton failed";
+  report.failure = !last_error.empty() ? SP_NEWTON_LINEAR_FAILED
+                   : !std::isfinite(last) ? SP_NEWTON_NOT_FINITE
+                   : !diverged.is_null() && diverged->getStatus() == Failed ? SP_NEWTON_DIVERGED
+                   : report.newton_its >= max_its ||
+                             report.factorisations >= options_.newton_max_its
+                       ? SP_NEWTON_MAX_ITERATIONS
+                       : SP_NEWTON_OTHER_FAILURE;
+  const std::string counts = std::to_string(report.newton_its) + " Newton iterations (" +
+                             std::to_string(report.factorisations) + " factorisations)";
+  std::string why;
+  switch (report.failure) {
+    case SP_NEWTON_LINEAR_FAILED: why = last_error; break;
+    case SP_NEWTON_NOT_FINITE: why = "the residual is not finite"; break;
+    case SP_NEWTON_DIVERGED:
+      why = "diverged: |F| above " + std::string(ratio) + " x the first |F| after " + counts;
+      break;
+    case SP_NEWTON_MAX_ITERATIONS: why = "no convergence in " + counts; break;
+    default: why = "Newton failed";
+  }
   snprintf(report.reason, sizeof report.reason, "%s (last |F| = %.3g)", why.c_str(), last);
   report.t_total = now() - t_start;
   return 1;  // state untouched: x0 was a copy

@@ -540,6 +540,8 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   sp_shape_coef *shape_coef = NULL; /* per cell, refreshed before each step */
   sp_cell_obs *obs_new = NULL;      /* adaptive, mass criterion: see mass_crossing */
   sp_step_costs seconds = {0}; /* of the step being attempted */
+  sp_attempt *attempts = NULL;  /* its failed attempts (seconds.failed_attempts) */
+  int cap_attempts = 0;
   double step_start = -1;
   int rc = SP_OK;
   while (rc == SP_OK && t < tc->t_end - t_tol && step < tc->max_steps) {
@@ -591,6 +593,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     int observed = 0; /* obs_new holds the observables of the step's end */
     const char *why = report.reason;
     char why_error[160];
+    int attempt_why = SP_ATTEMPT_NEWTON;
     if (solved == 0 && adaptive) {
       err = sp_scheme_error(kind, &run->hist, dt_try, run->state_old, run->state, n_pairs,
                             tc->rtol, tc->atol, run->scratch);
@@ -602,6 +605,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
     if (solved == 1) give_up = sp_dt_newton_failed(&run->dtc, dt_try);
     else if (sp_dt_judge(&run->dtc, dt_try, err) == SP_DT_REJECT) {
       solved = 1; /* never accepted: retried with a smaller step */
+      attempt_why = SP_ATTEMPT_ERROR;
       give_up = sp_dt_give_up(&run->dtc);
     } else if (adaptive && run->scene->division.criterion == SP_DIVIDE_BY_MASS &&
                n_cells < run->n_max) { /* observed here, kept if the step stands */
@@ -618,10 +622,26 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
         why = "a cell's mass passed its division mass inside the step (landing on it)";
         err = -1.0;
         solved = 1;
+        attempt_why = SP_ATTEMPT_LANDING;
       }
     }
     if (solved == 1) { /* retry from the last good state */
       memcpy(run->state, run->state_old, n_values * sizeof(double));
+      if (seconds.failed_attempts == cap_attempts) {
+        const int cap = 2 * cap_attempts + 4;
+        sp_attempt *grown = realloc(attempts, sizeof *attempts * (size_t)cap);
+        if (!grown) { rc = sp_error_set(SP_ERR_MEMORY, "out of memory"); break; }
+        attempts = grown;
+        cap_attempts = cap;
+      }
+      sp_attempt *a = &attempts[seconds.failed_attempts];
+      *a = (sp_attempt){.dt = dt_try, .why = attempt_why,
+                        .newton = attempt_why == SP_ATTEMPT_NEWTON ? report.failure : 0,
+                        .newton_its = report.newton_its, .factorisations = report.factorisations,
+                        .n_residuals = report.n_residuals,
+                        .error_estimate = attempt_why == SP_ATTEMPT_ERROR ? err : -1.0,
+                        .dt_next = run->dtc.dt_next};
+      memcpy(a->residual_norms, report.residual_norms, sizeof a->residual_norms);
       ++seconds.failed_attempts;
       ++sum->failed_attempts;
       seconds.failed_factorisations += report.factorisations;
@@ -715,7 +735,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
       const sp_step_info info = {.step = step, .t = t, .dt = dt_try, .t_end = tc->t_end,
                                  .n_cells = run->layout->n_cells,
                                  .newton_its = report.newton_its,
-                                 .failed_attempts = failed_before,
+                                 .failed_attempts = failed_before, .attempts = attempts,
                                  .error_estimate = err, .cells = run->obs,
                                  .wall_seconds = wall_clock() - run->t_start,
                                  .last = ends};
@@ -742,6 +762,7 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
   free(shape_coef);
   free(obs_new);
   free(core_mass_old);
+  free(attempts);
   return rc;
 }
 

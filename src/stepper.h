@@ -56,6 +56,29 @@ typedef struct {
 enum { SP_STOPPED_CALLBACK = 1, /**< a step callback returned non-zero */
        SP_STOPPED_SIGNAL = 2    /**< sp_run_request_stop: a checkpoint was written */ };
 
+/** Why an attempt at a step was not accepted (sp_attempt.why). */
+typedef enum {
+  SP_ATTEMPT_NEWTON = 1, /**< Newton failed (sp_attempt.newton says why) */
+  SP_ATTEMPT_ERROR,      /**< its local error estimate was above 1 */
+  SP_ATTEMPT_LANDING     /**< a cell's mass passed its division mass inside it:
+                              redone shorter, to land on the crossing */
+} sp_attempt_failure;
+
+/** A failed attempt at a step, retried with a smaller dt: what stderr
+ *  reports in words, as data (sp_step_info.attempts). */
+typedef struct {
+  double dt;             /**< the dt tried */
+  int why;               /**< sp_attempt_failure */
+  int newton;            /**< sp_newton_failure (softpack_solver.h) when why is
+                              SP_ATTEMPT_NEWTON, else 0 */
+  int newton_its;
+  int factorisations;
+  int n_residuals;       /**< entries of residual_norms: |F| per iteration */
+  double residual_norms[SP_MAX_NEWTON_HISTORY];
+  double error_estimate; /**< over its tolerance (SP_ATTEMPT_ERROR), else -1 */
+  double dt_next;        /**< the dt of the retry */
+} sp_attempt;
+
 /** What a step callback sees after each accepted step (the same on every
  *  MPI rank). */
 typedef struct {
@@ -64,6 +87,7 @@ typedef struct {
   int n_cells;
   int newton_its;        /**< of the accepted attempt */
   int failed_attempts;   /**< retried before it was accepted */
+  const sp_attempt *attempts; /**< those failed attempts, in order */
   double error_estimate; /**< over its tolerance (adaptive); -1: none */
   const sp_cell_obs *cells; /**< n_cells observables of the new state */
   double wall_seconds;   /**< since the run began */
