@@ -1,4 +1,6 @@
 #include "assembly.hpp"
+#include "errors.hpp"
+#include "fault.h"
 #include "jacobian_hand.hpp"
 
 #include <Epetra_FECrsGraph.h>
@@ -10,6 +12,19 @@
 #include <stdexcept>
 
 namespace sp {
+
+namespace {
+
+// The fault hook (src/fault.h): SOFTPACK_FAULT=assembly:RANK fails that
+// rank's residual fills, as if an allocation had failed there.
+void fault_at_assembly(int rank) {
+  if (sp_fault_due(SP_FAULT_ASSEMBLY, rank))
+    throw memory_error("out of memory at assembly on rank " + std::to_string(rank) +
+                       " (fault injected by SOFTPACK_FAULT=assembly:" + std::to_string(rank) +
+                       ")");
+}
+
+}  // namespace
 
 // Per-element scratch: the element's unknowns and step inputs, slot-major.
 struct Assembly::Gathered {
@@ -230,20 +245,23 @@ void Assembly::residual(const sp_step_data &d, const double *state,
   std::vector<double> R;
   std::vector<int> rows;
   std::vector<double> vals;
-  for (int e : my_elems_) {
-    gather(e, d, state, g);
-    const int n = 8 * g.n_cells;
-    R.assign(n, 0.0);
-    element_residual(geometry_[e], g.n_cells, g.u.data(), g.inputs(d), R.data());
-    rows.clear();
-    vals.clear();
-    for (int i = 0; i < n; ++i)
-      if (g.dof[i] >= 0) {
-        rows.push_back(g.dof[i]);
-        vals.push_back(R[i]);
-      }
-    fe.SumIntoGlobalValues((int)rows.size(), rows.data(), vals.data());
-  }
+  agree_local(comm_, [&] {
+    fault_at_assembly(comm_.MyPID());
+    for (int e : my_elems_) {
+      gather(e, d, state, g);
+      const int n = 8 * g.n_cells;
+      R.assign(n, 0.0);
+      element_residual(geometry_[e], g.n_cells, g.u.data(), g.inputs(d), R.data());
+      rows.clear();
+      vals.clear();
+      for (int i = 0; i < n; ++i)
+        if (g.dof[i] >= 0) {
+          rows.push_back(g.dof[i]);
+          vals.push_back(R[i]);
+        }
+      fe.SumIntoGlobalValues((int)rows.size(), rows.data(), vals.data());
+    }
+  });
   if (fe.GlobalAssemble(Add) != 0) throw std::runtime_error("residual assembly failed");
   F = *fe(0);
 }
@@ -254,56 +272,60 @@ void Assembly::jacobian(const sp_step_data &d, const double *state, int kind,
   Gathered g;
   std::vector<double> R, K, vals;
   std::vector<int> cols;
-  for (int e : my_elems_) {
-    gather(e, d, state, g);
-    const int nc = g.n_cells, n = 8 * nc;
-    R.assign(n, 0.0);
-    K.assign((size_t)n * n, 0.0);
-    element_matrix(e, d, g, kind, R.data(), K.data());
-    for (int i = 0; i < n; ++i) {
-      if (g.dof[i] < 0) continue;
-      const int j = i / 8, f = i % 2;
-      cols.clear();
-      vals.clear();
-      for (int i2 = 0; i2 < n; ++i2)
-        if (g.dof[i2] >= 0 && coupled(j, f, i2 / 8, i2 % 2)) {
-          cols.push_back(g.dof[i2]);
-          vals.push_back(K[(size_t)i * n + i2]);
-        }
-      int rc = J.SumIntoGlobalValues(g.dof[i], (int)cols.size(), vals.data(), cols.data());
-      if (rc < 0) throw std::runtime_error("Jacobian entry outside the graph");
+  agree_local(comm_, [&] {
+    for (int e : my_elems_) {
+      gather(e, d, state, g);
+      const int nc = g.n_cells, n = 8 * nc;
+      R.assign(n, 0.0);
+      K.assign((size_t)n * n, 0.0);
+      element_matrix(e, d, g, kind, R.data(), K.data());
+      for (int i = 0; i < n; ++i) {
+        if (g.dof[i] < 0) continue;
+        const int j = i / 8, f = i % 2;
+        cols.clear();
+        vals.clear();
+        for (int i2 = 0; i2 < n; ++i2)
+          if (g.dof[i2] >= 0 && coupled(j, f, i2 / 8, i2 % 2)) {
+            cols.push_back(g.dof[i2]);
+            vals.push_back(K[(size_t)i * n + i2]);
+          }
+        int rc = J.SumIntoGlobalValues(g.dof[i], (int)cols.size(), vals.data(), cols.data());
+        if (rc < 0) throw std::runtime_error("Jacobian entry outside the graph");
+      }
     }
-  }
+  });
   if (J.GlobalAssemble(false, Add, true) != 0)
     throw std::runtime_error("Jacobian assembly failed");
 }
 
 sp_energy_parts Assembly::energy(const sp_model_params &m, const double *state) const {
   double local[4] = {0, 0, 0, 0};  // bulk, gradient, repulsion, buffer
-  for (int e : my_elems_) {
-    const ElementGeometry &geo = geometry_[e];
-    const int nc = n_cells_on(e), s0 = elem_start_[e];
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      double sum_sq = 0, sum_4 = 0;
-      for (int j = 0; j < nc; ++j) {
-        double c = 0, gx = 0, gy = 0;
-        for (int a = 0; a < 4; ++a) {
-          int p = slot_pair_[4 * (s0 + j) + a];
-          double ca = p >= 0 ? state[2 * p] : 0.0;
-          c += geo.N[q][a] * ca;
-          gx += geo.dNdx[q][a][0] * ca;
-          gy += geo.dNdx[q][a][1] * ca;
+  agree_local(comm_, [&] {
+    for (int e : my_elems_) {
+      const ElementGeometry &geo = geometry_[e];
+      const int nc = n_cells_on(e), s0 = elem_start_[e];
+      for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+        double sum_sq = 0, sum_4 = 0;
+        for (int j = 0; j < nc; ++j) {
+          double c = 0, gx = 0, gy = 0;
+          for (int a = 0; a < 4; ++a) {
+            int p = slot_pair_[4 * (s0 + j) + a];
+            double ca = p >= 0 ? state[2 * p] : 0.0;
+            c += geo.N[q][a] * ca;
+            gx += geo.dNdx[q][a][0] * ca;
+            gy += geo.dNdx[q][a][1] * ca;
+          }
+          local[0] += geo.w[q] * well(m, c);
+          local[1] += geo.w[q] * 0.5 * m.kappa * (gx * gx + gy * gy);
+          sum_sq += c * c;
+          sum_4 += c * c * c * c;
+          if (geo.buffer) local[3] += geo.w[q] * m.lambda_b * c * c;
         }
-        local[0] += geo.w[q] * well(m, c);
-        local[1] += geo.w[q] * 0.5 * m.kappa * (gx * gx + gy * gy);
-        sum_sq += c * c;
-        sum_4 += c * c * c * c;
-        if (geo.buffer) local[3] += geo.w[q] * m.lambda_b * c * c;
+        // lambda sum_{k<l} c_k^2 c_l^2 = lambda/2 ((sum c^2)^2 - sum c^4)
+        local[2] += geo.w[q] * 0.5 * m.lambda * (sum_sq * sum_sq - sum_4);
       }
-      // lambda sum_{k<l} c_k^2 c_l^2 = lambda/2 ((sum c^2)^2 - sum c^4)
-      local[2] += geo.w[q] * 0.5 * m.lambda * (sum_sq * sum_sq - sum_4);
     }
-  }
+  });
   double global[4];
   comm_.SumAll(local, global, 4);
   return sp_energy_parts{global[0], global[1], global[2], global[3]};
@@ -318,25 +340,27 @@ double Assembly::compare_jacobians(const sp_step_data &d, const double *state, i
   Gathered g;
   std::vector<double> Ra, Ka, Rb, Kb;
   double worst = 0.0;
-  for (int e : my_elems_) {
-    gather(e, d, state, g);
-    const int n = 8 * g.n_cells;
-    Ra.assign(n, 0.0); Rb.assign(n, 0.0);
-    Ka.assign((size_t)n * n, 0.0); Kb.assign((size_t)n * n, 0.0);
-    element_matrix(e, d, g, kind_a, Ra.data(), Ka.data());
-    element_matrix(e, d, g, kind_b, Rb.data(), Kb.data());
-    double scale = 0.0, diff = 0.0;
-    for (int i = 0; i < n; ++i) {
-      if (g.dof[i] < 0) continue;
-      for (int j = 0; j < n; ++j) {
-        if (g.dof[j] < 0) continue;
-        scale = std::max(scale, std::fabs(Kb[(size_t)i * n + j]));
-        diff = std::max(diff, std::fabs(Ka[(size_t)i * n + j] - Kb[(size_t)i * n + j]));
+  agree_local(comm_, [&] {
+    for (int e : my_elems_) {
+      gather(e, d, state, g);
+      const int n = 8 * g.n_cells;
+      Ra.assign(n, 0.0); Rb.assign(n, 0.0);
+      Ka.assign((size_t)n * n, 0.0); Kb.assign((size_t)n * n, 0.0);
+      element_matrix(e, d, g, kind_a, Ra.data(), Ka.data());
+      element_matrix(e, d, g, kind_b, Rb.data(), Kb.data());
+      double scale = 0.0, diff = 0.0;
+      for (int i = 0; i < n; ++i) {
+        if (g.dof[i] < 0) continue;
+        for (int j = 0; j < n; ++j) {
+          if (g.dof[j] < 0) continue;
+          scale = std::max(scale, std::fabs(Kb[(size_t)i * n + j]));
+          diff = std::max(diff, std::fabs(Ka[(size_t)i * n + j] - Kb[(size_t)i * n + j]));
+        }
       }
+      if (scale > 0) worst = std::max(worst, diff / scale);
+      else if (diff > 0) worst = INFINITY;
     }
-    if (scale > 0) worst = std::max(worst, diff / scale);
-    else if (diff > 0) worst = INFINITY;
-  }
+  });
   double global;
   comm_.MaxAll(&worst, &global, 1);
   return global;
@@ -344,24 +368,26 @@ double Assembly::compare_jacobians(const sp_step_data &d, const double *state, i
 
 void Assembly::shape_weights(const sp_step_data &d, std::vector<double> &u) const {
   std::vector<double> mine(2 * (size_t)n_pairs_, 0.0);
-  for (int e : my_elems_) {
-    const ElementGeometry &geo = geometry_[e];
-    const int nc = n_cells_on(e), s0 = elem_start_[e];
-    for (int j = 0; j < nc; ++j) {
-      const sp_shape_coef &sc = d.shape[slot_cell_[s0 + j]];
-      const int *pairs = &slot_pair_[4 * (s0 + j)];
-      for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-        double c_old = 0.0;
-        for (int a = 0; a < 4; ++a) c_old += geo.N[q][a] * d.state_old[2 * pairs[a]];
-        if (c_old < sc.threshold) continue;  // the mask of element_residual
-        const double xb = geo.x[q][0] - sc.xc, yb = geo.x[q][1] - sc.yc;
-        for (int i = 0; i < 2; ++i) {
-          const double ihat = shape_ihat(sc.v[i], xb, yb);
-          for (int a = 0; a < 4; ++a) mine[2 * pairs[a] + i] += geo.w[q] * geo.N[q][a] * ihat;
+  agree_local(comm_, [&] {
+    for (int e : my_elems_) {
+      const ElementGeometry &geo = geometry_[e];
+      const int nc = n_cells_on(e), s0 = elem_start_[e];
+      for (int j = 0; j < nc; ++j) {
+        const sp_shape_coef &sc = d.shape[slot_cell_[s0 + j]];
+        const int *pairs = &slot_pair_[4 * (s0 + j)];
+        for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+          double c_old = 0.0;
+          for (int a = 0; a < 4; ++a) c_old += geo.N[q][a] * d.state_old[2 * pairs[a]];
+          if (c_old < sc.threshold) continue;  // the mask of element_residual
+          const double xb = geo.x[q][0] - sc.xc, yb = geo.x[q][1] - sc.yc;
+          for (int i = 0; i < 2; ++i) {
+            const double ihat = shape_ihat(sc.v[i], xb, yb);
+            for (int a = 0; a < 4; ++a) mine[2 * pairs[a] + i] += geo.w[q] * geo.N[q][a] * ihat;
+          }
         }
       }
     }
-  }
+  });
   u.resize(mine.size());
   if (comm_.SumAll(mine.data(), u.data(), (int)mine.size()) != 0)
     throw std::runtime_error("shape weights: reduction failed");

@@ -34,6 +34,9 @@ template <class F> int guarded(sp_solver s, F &&body) {
   } catch (const std::bad_alloc &e) {
     keep(std::string("out of memory in the Trilinos glue (") + e.what() + ")");
     return SP_SOLVER_ERR_MEMORY;
+  } catch (const sp::memory_error &e) {
+    keep(e.what());
+    return SP_SOLVER_ERR_MEMORY;
   } catch (const sp::mpi_error &e) {
     keep(e.what());
     return SP_SOLVER_ERR_MPI;

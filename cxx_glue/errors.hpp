@@ -8,8 +8,11 @@
 
 #include <mpi.h>
 
+#include <functional>
 #include <stdexcept>
 #include <string>
+
+class Epetra_Comm;
 
 namespace sp {
 
@@ -17,6 +20,13 @@ namespace sp {
 // names the scene key): bad input, exit status 2.
 struct input_error : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
+};
+
+// Out of memory, with a message (std::bad_alloc carries none): what the
+// other ranks throw when one rank ran out (agree_local), and the fault
+// hook's stand-in for an allocation that failed.
+struct memory_error : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 // An MPI call that returned an error code.
@@ -33,5 +43,13 @@ inline void check_mpi(int code, const char *call) {
   MPI_Error_string(code, text, &len);
   throw mpi_error(std::string("MPI: ") + call + " failed: " + text);
 }
+
+// Run @p local, the rank-local part of a step that a collective follows
+// (an element loop before GlobalAssemble or SumAll). If it threw on any
+// rank, every rank throws before the collective, so none is left waiting
+// in it: the failing rank (the lowest, if several) its own exception, the
+// others one of the same class naming that rank and its message. One
+// integer reduction when nothing failed; nothing on one process.
+void agree_local(const Epetra_Comm &comm, const std::function<void()> &local);
 
 }  // namespace sp

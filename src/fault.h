@@ -14,7 +14,10 @@
  *  - solver: in the glue's sp_solver_create (a solver error, class
  *            SP_SOLVER_ERR_SOLVER);
  *  - step:   before every Newton solve (SP_ERR_MEMORY);
- *  - output: at every field snapshot, step 0's included (SP_ERR_IO).
+ *  - output: at every field snapshot, step 0's included (SP_ERR_IO);
+ *  - assembly: in the glue's residual fill (its element loop, before the
+ *            fill's collective: a memory error on that rank, the other
+ *            ranks told before the collective, cxx_glue/errors.hpp).
  * With ":kill" the rank sends itself SIGKILL there instead (not for
  * solver). Anything else in SOFTPACK_FAULT is bad input at set-up.
  * docs/robustness.md, "MPI failures".
@@ -30,7 +33,8 @@ typedef enum {
   SP_FAULT_SETUP = 0,
   SP_FAULT_SOLVER = 1,
   SP_FAULT_STEP = 2,
-  SP_FAULT_OUTPUT = 3
+  SP_FAULT_OUTPUT = 3,
+  SP_FAULT_ASSEMBLY = 4
 } sp_fault_phase;
 
 /** @brief 1 if SOFTPACK_FAULT asks @p rank to fail at @p phase (a ":kill"

@@ -19,7 +19,8 @@
  *   mpi_compare library SCENE [section.key=value]...
  *     The library under faults (src/fault.h): with SOFTPACK_FAULT set on
  *     every rank to a fault on one rank (at set-up, in the solver's
- *     creation, in a step, at output; rank 1, and rank 0 for some),
+ *     creation, in a step, at output, inside the glue's residual fill
+ *     before its collective; rank 1, and rank 0 for some),
  *     sp_run_file returns on every rank with the fault's class
  *     (memory, solver, output) and a message naming it; then a run without
  *     a fault succeeds on every rank (the library is usable after them),
@@ -27,7 +28,8 @@
  *
  *   mpi_compare faults         (run without mpirun)
  *     The real program under `mpirun -np 2` with a fault on rank 1 at
- *     set-up, in the solver's creation, in a step and at output: every run
+ *     set-up, in the solver's creation, in a step, at output and in the
+ *     glue's residual fill: every run
  *     ends within seconds (timeout -s KILL 60 makes a hang fail), exit
  *     status 1, the message on stderr; and rank 1 killed by SIGKILL in a
  *     step ends the run (mpirun tears the job down), not a hang.
@@ -342,7 +344,8 @@ static int cmd_library(int argc, char **argv, int rank) {
     int code;
   } cases[] = {{"setup:1", SP_ERR_MEMORY}, {"solver:1", SP_ERR_SOLVER},
                {"step:1", SP_ERR_MEMORY},  {"output:1", SP_ERR_IO},
-               {"step:0", SP_ERR_MEMORY},  {"output:0", SP_ERR_IO}};
+               {"step:0", SP_ERR_MEMORY},  {"output:0", SP_ERR_IO},
+               {"assembly:1", SP_ERR_MEMORY}, {"assembly:0", SP_ERR_MEMORY}};
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
     setenv("SOFTPACK_FAULT", cases[i].fault, 1);
     const double t0 = MPI_Wtime();
@@ -447,7 +450,8 @@ static int cmd_faults(void) {
       {"setup:1", "(memory)", "rank 1 of 2", "setup"},
       {"solver:1", "(solver)", "rank 1", "solver"},
       {"step:1", "(memory)", "rank 1 of 2", "step"},
-      {"output:1", "(output)", "rank 1 of 2", "fields"}};
+      {"output:1", "(output)", "rank 1 of 2", "fields"},
+      {"assembly:1", "(memory)", "rank 1", "assembly"}};
   for (size_t i = 0; i < sizeof faults / sizeof faults[0]; ++i) {
     char what[64];
     snprintf(what, sizeof what, "SOFTPACK_FAULT=%s, np 2", faults[i][0]);
