@@ -87,3 +87,10 @@ void sp_layout_destroy(sp_layout **layout) {
   free(*layout);
   *layout = NULL;
 }
+
+long long sp_layout_nonzeros_bound(const sp_layout *layout) {
+  long long bound = 0;
+  for (int i = 0; i < layout->n_nodes; ++i)
+    bound += sp_nonzeros_bound(1, layout->node_start[i + 1] - layout->node_start[i]);
+  return bound;
+}

@@ -24,6 +24,22 @@ extern "C" {
  *  32-bit ints) are all ints. */
 #define SP_LAYOUT_MAX_PAIRS (INT_MAX / 2)
 
+/** The most nonzeros the solver's matrix may have: its row offsets are
+ *  ints in Epetra (per rank), serial SuperLU and SuperLU_DIST (global
+ *  counts), and the serial backends gather every row on one process. */
+#define SP_LAYOUT_MAX_NONZEROS ((long long)INT_MAX)
+
+/** An upper bound of the Jacobian's nonzeros on a layout whose node i
+ *  carries n_i cells: a cell lives on an element only if all four nodes
+ *  carry it, so every cell coupled to (k, i) is at node i too; the c row of
+ *  (k, i) has at most 9 x 2 entries (c_k and mu_k at i and its 8
+ *  neighbours), the mu row at most 9 x (n_i + 1) (c_k, mu_k and the other
+ *  cells' c): sum over nodes of 9 n_i (n_i + 3). Exact inside a full
+ *  layout of a structured mesh; an overestimate at boundaries. */
+static inline long long sp_nonzeros_bound(long long n_nodes, long long n_i) {
+  return 9 * n_nodes * n_i * (n_i + 3);
+}
+
 typedef struct sp_layout {
   int n_nodes;
   int n_cells;
@@ -44,6 +60,9 @@ int sp_layout_create_full(int n_nodes, int n_cells, sp_layout **out);
 int sp_layout_create_from_masks(int n_nodes, int n_cells,
                                 const unsigned char *in_support,
                                 sp_layout **out);
+
+/** @brief sp_nonzeros_bound summed over the layout's nodes. */
+long long sp_layout_nonzeros_bound(const sp_layout *layout);
 
 /** @brief The pair of (cell, node), or -1 if node is outside the support. */
 int sp_layout_pair(const sp_layout *layout, int cell, int node);

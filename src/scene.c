@@ -1400,6 +1400,20 @@ static int check_sizes(const sp_scene *scene, const char *file) {
            "solver's 32-bit indices (Epetra's global ids): use fewer elements or cells",
            file, mesh_keys, scene->n_cells, nodes, scene->n_cells, pairs, pairs,
            SP_LAYOUT_MAX_PAIRS);
+  /* A run that keeps every cell on every node hands that layout to the
+   * solver: its matrix's nonzeros must fit too (sp_nonzeros_bound). Local
+   * supports are checked when each layout is handed over (the run's). */
+  const int full = scene->layout.support == SP_SUPPORT_FULL ||
+                   (scene->layout.support == SP_SUPPORT_AUTO && scene->n_cells <= 4 &&
+                    scene->division.criterion == SP_DIVIDE_NONE);
+  const long long nonzeros = sp_nonzeros_bound(nodes, scene->n_cells);
+  SP_CHECK(!full || nonzeros <= SP_LAYOUT_MAX_NONZEROS, SP_ERR_INPUT,
+           "%s: %s, cells (%d cells) and layout.support (every cell on every node): too "
+           "large: the Jacobian would hold up to %lld nonzeros (%lld nodes x 9 x %d x %d), "
+           "more than the %lld the solvers' 32-bit offsets count: use fewer elements or "
+           "cells, or layout.support: local",
+           file, mesh_keys, scene->n_cells, nonzeros, nodes, scene->n_cells,
+           scene->n_cells + 3, SP_LAYOUT_MAX_NONZEROS);
   return SP_OK;
 }
 

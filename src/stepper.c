@@ -65,6 +65,12 @@ void sp_model_from_scene(const sp_scene *scene, sp_model_params *model) {
 }
 
 int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *layout) {
+  const long long nonzeros = sp_layout_nonzeros_bound(layout);
+  SP_CHECK(nonzeros <= SP_LAYOUT_MAX_NONZEROS, SP_ERR_MEMORY,
+           "layout: %d cells on %d (cell, node) pairs: the Jacobian would hold up to %lld "
+           "nonzeros, more than the %lld the solvers' 32-bit offsets count (fewer cells per "
+           "node: layout.support: local, a smaller layout.margin)",
+           layout->n_cells, layout->n_pairs, nonzeros, SP_LAYOUT_MAX_NONZEROS);
   const int n_ranks = sp_solver_ranks(solver);
   SP_CHECK(n_ranks >= 1, SP_ERR_INTERNAL, "solver setup: the solver has no communicator");
   int *first_node;

@@ -7,6 +7,8 @@
  *   (exit 1, "softpack: error (solver)"), not bad input;
  * - a failed allocation at set-up (SOFTPACK_FAULT=setup:0) is a memory
  *   error, exit 1; a malformed SOFTPACK_FAULT is bad input naming it;
+ * - a layout whose Jacobian would overflow 32-bit offsets is refused (memory)
+ *   before the glue sees it;
  * - bad input in the scene still exits 2. */
 #include <stdlib.h>
 #include <string.h>
@@ -14,8 +16,10 @@
 
 #include "check.h"
 #include "command.h"
+#include "layout.h"
 #include "run.h"
 #include "solver_status.h"
+#include "stepper.h"
 
 static const char scene[] =
     "mesh: {type: rectangle, x0: 0, y0: 0, x1: 1, y1: 1, nx: 12, ny: 12}\n"
@@ -70,9 +74,22 @@ int main(int argc, char **argv) {
   CHECK(sp_solver_create(MPI_COMM_WORLD, &opt, &s) == SP_SOLVER_OK, "create: %s",
         sp_solver_last_error(s));
   sp_step_report report;
+  int rc;
   status = sp_solver_step(s, NULL, NULL, &report);
   CHECK(status == SP_SOLVER_ERR_INTERNAL, "a step with null data: status %d", status);
   sp_solver_destroy(&s);
+
+  /* a layout whose Jacobian could not be counted in 32 bits (4 cells on
+   * each of 2938 x 2901 nodes: up to 2,147,830,776 nonzeros) is refused
+   * before the glue sees it, as too large (memory), not as bad input */
+  sp_layout *huge = NULL;
+  CHECK_OK(sp_layout_create_full(2938 * 2901, 4, &huge));
+  CHECK(sp_layout_nonzeros_bound(huge) == 2147830776LL, "bound %lld",
+        sp_layout_nonzeros_bound(huge));
+  rc = sp_solver_attach(NULL, NULL, huge);
+  CHECK(rc == SP_ERR_MEMORY && strstr(sp_error_message(), "nonzeros"),
+        "a layout with too many nonzeros: rc %d: %s", rc, sp_error_message());
+  sp_layout_destroy(&huge);
 
   /* each class its code, and only bad input exits 2 */
   const int classes[][2] = {{SP_SOLVER_OK, SP_OK},
@@ -93,7 +110,7 @@ int main(int argc, char **argv) {
 
   /* a failed solver creation through the library: a solver error */
   system("rm -rf classes_solver");
-  int rc = run_with_fault("solver:0", "classes_solver");
+  rc = run_with_fault("solver:0", "classes_solver");
   printf("solver fault: %d, %s\n", rc, sp_error_message());
   CHECK(rc == SP_ERR_SOLVER && strstr(sp_error_message(), "SOFTPACK_FAULT=solver:0"),
         "solver fault: rc %d: %s", rc, sp_error_message());

@@ -377,6 +377,18 @@ static void test_sizes(void) {
   sp_scene_destroy(&s);
   expect_input_error(path, 1, too_large, "mesh.nx", "64 cells");
   expect_input_error(path, 0, NULL, "mesh.ny", "64 cells");
+  /* too_many_nonzeros.yaml: 4 cells on every node; the pairs fit, the
+   * Jacobian's nonzeros (9 x 4 x 7 per node) fit up to nx = 2936:
+   * 2937 x 2901 x 252 = 2,147,099,724 <= 2^31 - 1 < 2938 x 2901 x 252 */
+  source_path("tests/scenes/bad/too_many_nonzeros.yaml", path);
+  const char *nz_fits[] = {"mesh.nx=2936"}, *nz_auto[] = {"layout.support=auto"},
+             *nz_local[] = {"layout.support=local"};
+  CHECK(sp_scene_load(path, 1, nz_fits, &s) == SP_OK, "nx = 2936: %s", sp_error_message());
+  sp_scene_destroy(&s);
+  expect_input_error(path, 0, NULL, "layout.support", "nonzeros");
+  expect_input_error(path, 1, nz_auto, "mesh.nx", "nonzeros"); /* auto: full for 4 cells */
+  CHECK(sp_scene_load(path, 1, nz_local, &s) == SP_OK, "local supports: %s", sp_error_message());
+  sp_scene_destroy(&s);
 }
 
 /* The scene reader from memory (what the fuzz target feeds): the same
