@@ -16,15 +16,21 @@ namespace sp {
 // contiguous row blocks in rank order: rank r holds rows first_row ..
 // first_row + n_rows - 1, and the blocks of ranks 0, 1, ... follow each
 // other (what SuperLU_DIST's SLU_NR_loc format wants). One rank: first_row
-// = 0, n_rows = n_global. Column indices are global and 0-based; the arrays
-// are borrowed for the call only (every backend copies what it keeps).
+// = 0, n_rows = n_global. Column indices are global and 0-based. The
+// arrays are borrowed for the call only, and the values are the backend's
+// to overwrite: the caller fills them anew before every factor() (Solver's
+// sorted copy of the Jacobian's rows, linear_gather's gathered rows), so a
+// backend that works in place (SuperLU_DIST scales and permutes them)
+// needs no copy of its own, and one that only reads them during the call
+// (serial SuperLU) neither. The Jacobian's values then exist twice per
+// rank: the Epetra matrix and those rows (docs/design.md).
 struct CsrRows {
   int n_global = 0;
   int first_row = 0;
   int n_rows = 0;
   const int *row_ptr = nullptr;  // n_rows + 1 offsets into col/val
   const int *col = nullptr;      // global column indices
-  const double *val = nullptr;
+  double *val = nullptr;         // overwritten by some backends' factor()
 };
 
 // Every call is collective over the solver's communicator.

@@ -42,16 +42,13 @@ class SuperLU final : public DirectSolver {
       return false;
     }
     const int n = A.n_global;
-    const int *row_ptr = A.row_ptr, *col = A.col;
-    const double *val = A.val;
-    const int nnz = row_ptr[n];
-    // SuperLU keeps pointers into A: own copies of the arrays.
-    ptr_.assign(row_ptr, row_ptr + n + 1);
-    idx_.assign(col, col + nnz);
-    val_.assign(val, val + nnz);
+    const int nnz = A.row_ptr[n];
+    // A view of the caller's rows (SuperLU's matrix types take non-const
+    // pointers): dgstrf reads A during this call only and changes nothing
+    // in it (no equilibration here); the factors L and U are SuperLU's own.
     SuperMatrix At;  // CSC of A^T = CSR of A
-    dCreate_CompCol_Matrix(&At, n, n, nnz, val_.data(), idx_.data(), ptr_.data(),
-                           SLU_NC, SLU_D, SLU_GE);
+    dCreate_CompCol_Matrix(&At, n, n, nnz, A.val, const_cast<int *>(A.col),
+                           const_cast<int *>(A.row_ptr), SLU_NC, SLU_D, SLU_GE);
     if (!same_pattern || (int)perm_c_.size() != n) {
       perm_c_.assign(n, 0);
       get_perm_c(options_.ColPerm, &At, perm_c_.data());
@@ -117,8 +114,7 @@ class SuperLU final : public DirectSolver {
   SuperMatrix L_, U_;
   bool have_factors_ = false;
   int n_ = 0, symbolic_ = 0;
-  std::vector<int> ptr_, idx_, perm_c_, perm_r_, etree_;
-  std::vector<double> val_;
+  std::vector<int> perm_c_, perm_r_, etree_;
 };
 
 }  // namespace

@@ -87,13 +87,15 @@ class SuperLUDist final : public DirectSolver {
       if (options_.SolveInitialized == YES) dSolveFinalize(&options_, &solve_);
       if (have_lu_) dDestroy_LU(n_, &grid_, &lu_);
     }
-    // Fresh copies of what pdgssvx overwrote last time.
+    // Fresh copies of the pattern pdgssvx overwrote last time; the values
+    // are the caller's to overwrite (linear.hpp: filled anew before every
+    // factor(), left alone until the next, so the solves' refinement may
+    // read them).
     const int nnz = A.row_ptr[A.n_rows];
     ptr_.assign(ptr_saved_.begin(), ptr_saved_.end());
     col_.assign(col_saved_.begin(), col_saved_.end());
-    val_.assign(A.val, A.val + nnz);
     if (have_matrix_) Destroy_SuperMatrix_Store_dist(&A_);
-    dCreate_CompRowLoc_Matrix_dist(&A_, n_, n_, nnz, m_loc_, fst_row_, val_.data(), col_.data(),
+    dCreate_CompRowLoc_Matrix_dist(&A_, n_, n_, nnz, m_loc_, fst_row_, A.val, col_.data(),
                                    ptr_.data(), SLU_NR_loc, SLU_D, SLU_GE);
     have_matrix_ = true;
 
@@ -247,7 +249,6 @@ class SuperLUDist final : public DirectSolver {
   bool pair_order_;  // METIS on the pair graph (else on the unknowns)
   int solve_nrhs_ = 1, next_nrhs_ = 1;  // columns of the solve set-up, and of the next
   std::vector<int_t> ptr_saved_, col_saved_, ptr_, col_;
-  std::vector<double> val_;
 };
 
 static_assert(sizeof(int_t) == sizeof(int), "SuperLU_DIST built with 64-bit indices");
