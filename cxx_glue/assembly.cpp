@@ -134,6 +134,10 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
   }
   if (graph.GlobalAssemble() != 0) throw std::runtime_error("graph assembly failed");
   graph_.reset(new Epetra_CrsGraph(graph));
+  // Contiguous storage (one array of column indices, one offset array): a
+  // matrix made on this graph keeps its values in one array too, which
+  // Solver hands to a backend as they are on one process (newton.cpp).
+  if (graph_->OptimizeStorage() != 0) throw std::runtime_error("graph: OptimizeStorage failed");
 }
 
 // Binary search of (cell, node) in the copied layout (pairs sorted by cell).

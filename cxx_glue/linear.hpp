@@ -60,6 +60,10 @@ class DirectSolver {
   virtual long iterations() const { return 0; }
   // Number of symbolic analyses done (for tests of the reuse).
   virtual int symbolic_count() const = 0;
+  // Whether factor() writes into A.val (else it only reads A during the
+  // call, and the caller may hand it storage it keeps using: Solver gives
+  // the Jacobian's own arrays on one process).
+  virtual bool overwrites_values() const { return false; }
 };
 
 // Serial SuperLU (dgstrf/dgstrs on the transposed CSC view of the CSR); one

@@ -155,6 +155,7 @@ class SuperLUDist final : public DirectSolver {
   void set_rhs_count(int nrhs) override { next_nrhs_ = nrhs; }
 
   int symbolic_count() const override { return symbolic_; }
+  bool overwrites_values() const override { return true; }  // pdgssvx scales, permutes
 
  private:
   // METIS (as SuperLU_DIST calls it, on A + A^T) on the graph of the

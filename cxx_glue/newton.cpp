@@ -301,7 +301,24 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
     }
     csr_ptr_.push_back((int)csr_col_.size());
   }
-  csr_val_.assign(csr_col_.size(), 0.0);
+  // On one process the column map is the row map and Epetra keeps each
+  // row sorted by local index, so its arrays are those rows already: a
+  // backend that only reads them reads the Jacobian's own storage.
+  rows_in_place_ = comm_.NumProc() == 1 && !linear_->overwrites_values() &&
+                   jacobian_matrix->StorageOptimized() &&
+                   g.ColMap().NumMyElements() == n_global_;
+  for (int k = 0; rows_in_place_ && k < g.ColMap().NumMyElements(); ++k)
+    rows_in_place_ = g.ColMap().GID(k) == k;
+  for (int i = 0; rows_in_place_ && i < n; ++i)  // each row's entries in Epetra's order
+    for (int k = csr_ptr_[i]; rows_in_place_ && k < csr_ptr_[i + 1]; ++k)
+      rows_in_place_ = csr_from_[k] == k - csr_ptr_[i];
+  if (rows_in_place_) {
+    std::vector<int>().swap(csr_col_);
+    std::vector<int>().swap(csr_from_);
+    std::vector<double>().swap(csr_val_);
+  } else {
+    csr_val_.assign(csr_col_.size(), 0.0);
+  }
   pattern_changed_ = true;
   jacobian_fresh_ = false;
 }
@@ -384,19 +401,29 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
   if (fresh) {
     double t0 = now();
     const int n = (int)csr_ptr_.size() - 1;
-    for (int i = 0; i < n; ++i) {
-      int len;
-      double *vals;
-      jacobian_matrix->ExtractMyRowView(i, len, vals);
-      for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = vals[csr_from_[k]];
-    }
     CsrRows A;
     A.n_global = n_global_;
     A.first_row = first_row_;
     A.n_rows = n;
-    A.row_ptr = csr_ptr_.data();
-    A.col = csr_col_.data();
-    A.val = csr_val_.data();
+    if (rows_in_place_) {
+      int *offsets, *cols;
+      double *vals;
+      if (jacobian_matrix->ExtractCrsDataPointers(offsets, cols, vals) != 0)
+        throw std::logic_error("the Jacobian's storage is not contiguous");
+      A.row_ptr = offsets;
+      A.col = cols;
+      A.val = vals;
+    } else {
+      for (int i = 0; i < n; ++i) {
+        int len;
+        double *vals;
+        jacobian_matrix->ExtractMyRowView(i, len, vals);
+        for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = vals[csr_from_[k]];
+      }
+      A.row_ptr = csr_ptr_.data();
+      A.col = csr_col_.data();
+      A.val = csr_val_.data();
+    }
     linear_->set_rhs_count(1);
     bool ok = linear_->factor(A, !pattern_changed_, why);
     ok = all_agree(comm_.Comm(), ok, why);

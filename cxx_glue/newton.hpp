@@ -83,6 +83,10 @@ class Solver {
   std::vector<int> csr_from_;           // position of each entry in its Epetra row
   int first_row_ = 0, n_global_ = 0;    // the rows are first_row_ .. + n_rows - 1
   std::vector<double> csr_val_;
+  // One process, a backend that only reads, and Epetra's rows already in
+  // the sorted order: the backend reads the Jacobian's own arrays and the
+  // csr_* copies are not kept (the values exist once, docs/design.md).
+  bool rows_in_place_ = false;
   bool jacobian_fresh_ = false;  // the matrix changed since the last factor
   bool pattern_changed_ = true;  // the layout changed since the last factor
   int step_factorisations_ = 0;  // factorisations in the current step
