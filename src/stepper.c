@@ -269,14 +269,7 @@ static int update_supports(sp_run *run, sp_energy_parts *after) {
 static int layout_with_child(sp_run *run, int parent, sp_layout **out) {
   const int n = run->layout->n_cells, nn = run->mesh->n_nodes;
   if (!run->support) return sp_layout_create_full(nn, n + 1, out);
-  unsigned char *mask;
-  SP_ALLOC(mask, (size_t)nn * (n + 1));
-  for (int k = 0; k <= n; ++k)
-    for (int i = 0; i < nn; ++i)
-      mask[(size_t)k * nn + i] = sp_layout_pair(run->layout, k < n ? k : parent, i) >= 0;
-  int rc = sp_layout_create_from_masks(nn, n + 1, mask, out);
-  free(mask);
-  return rc;
+  return sp_layout_with_child(run->layout, parent, out);
 }
 
 /**
