@@ -71,8 +71,15 @@ int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *lay
   SP_ALLOC(first_node, (size_t)n_ranks + 1);
   sp_partition_ranges(layout, n_ranks, first_node);
   sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
+  const sp_slots *slots; /* the element-slot table: the glue's too */
+  const int rc = sp_layout_slots(layout, mesh, &slots);
+  if (rc != SP_OK) {
+    free(first_node);
+    return rc;
+  }
   sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
-                       layout->pair_cell, first_node, n_ranks};
+                       layout->pair_cell, first_node, n_ranks, slots->n_slots,
+                       slots->elem_start, slots->slot_cell, slots->slot_pair};
   const int status = sp_solver_set_problem(solver, &mv, &lv);
   free(first_node);
   if (status != SP_SOLVER_OK) return sp_solver_failed(solver, status, "solver setup");
