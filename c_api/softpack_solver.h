@@ -13,6 +13,7 @@
 #define SOFTPACK_SOLVER_H
 
 #include <mpi.h>
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -119,6 +120,15 @@ typedef struct {
    *  communicator size). NULL: equal node counts per rank. */
   const int *rank_first_node;
   int n_ranks;
+  /** The element-slot table (src/layout.h, sp_slots; required): element
+   *  e's cells are slot_cell[elem_start[e] .. elem_start[e+1]-1], by
+   *  increasing cell, each with the pairs of the element's four nodes at
+   *  slot_pair[4 s .. 4 s + 3]. The C core applies the whole-element rule
+   *  once (sp_layout_slots); the glue takes the table as it is. */
+  int64_t n_slots;
+  const int64_t *elem_start; /**< n_elems + 1 (the mesh's) */
+  const int *slot_cell;      /**< n_slots */
+  const int *slot_pair;      /**< 4 n_slots */
 } sp_layout_view;
 
 /** Model parameters (MODEL.md). */

@@ -76,9 +76,17 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
     }
   map_.reset(new Epetra_Map(-1, (int)my_dofs.size(), my_dofs.data(), 0, comm));
 
-  // Elements: geometry, cells present (union over the nodes), pairs.
+  // Elements: geometry, and the cells living on each with their pairs: the
+  // C core's element-slot table (sp_layout_slots, the one place the
+  // whole-element rule is applied), copied since the view is borrowed.
+  if (!layout.elem_start || !layout.slot_cell || !layout.slot_pair ||
+      layout.elem_start[0] != 0 || layout.elem_start[mesh.n_elems] != layout.n_slots)
+    throw std::runtime_error("the layout view has no element-slot table for the mesh's " +
+                             std::to_string(mesh.n_elems) + " elements");
+  elem_start_.assign(layout.elem_start, layout.elem_start + mesh.n_elems + 1);
+  slot_cell_.assign(layout.slot_cell, layout.slot_cell + layout.n_slots);
+  slot_pair_.assign(layout.slot_pair, layout.slot_pair + 4 * layout.n_slots);
   geometry_.resize(mesh.n_elems);
-  elem_start_.assign(1, 0);
   for (int e = 0; e < mesh.n_elems; ++e) {
     const int *nodes = mesh.elem + 4 * e;
     ElementGeometry &g = geometry_[e];
@@ -92,19 +100,6 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
         throw std::runtime_error("mesh element " + std::to_string(e) +
                                  " is inverted or degenerate");
     g.buffer = mesh.region && mesh.region[e] == 1;
-    // Cell k lives on element e only if all four nodes are in its support:
-    // its field's domain is then a union of whole elements, with a natural
-    // (no-flux) boundary, so mass is conserved exactly on any support.
-    for (int p0 = node_start_[nodes[0]]; p0 < node_start_[nodes[0] + 1]; ++p0) {
-      const int k = pair_cell_[p0];
-      int pairs[4] = {p0, -1, -1, -1};
-      bool whole = true;
-      for (int a = 1; a < 4 && whole; ++a) whole = (pairs[a] = sp_layout_pair_of(k, nodes[a])) >= 0;
-      if (!whole) continue;
-      slot_cell_.push_back(k);
-      slot_pair_.insert(slot_pair_.end(), pairs, pairs + 4);
-    }
-    elem_start_.push_back((int)slot_cell_.size());
     if (nodes[0] >= first_node && nodes[0] < end_node) my_elems_.push_back(e);
   }
 
@@ -112,7 +107,8 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
   Epetra_FECrsGraph graph(Copy, *map_, 0);
   Gathered scratch;
   for (int e : my_elems_) {
-    const int nc = n_cells_on(e), s0 = elem_start_[e];
+    const int nc = n_cells_on(e);
+    const int64_t s0 = elem_start_[e];
     for (int j = 0; j < nc; ++j)
       for (int a = 0; a < 4; ++a) {
         int p = slot_pair_[4 * (s0 + j) + a];
@@ -140,14 +136,6 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
   if (graph_->OptimizeStorage() != 0) throw std::runtime_error("graph: OptimizeStorage failed");
 }
 
-// Binary search of (cell, node) in the copied layout (pairs sorted by cell).
-int Assembly::sp_layout_pair_of(int cell, int node) const {
-  auto first = pair_cell_.begin() + node_start_[node];
-  auto last = pair_cell_.begin() + node_start_[node + 1];
-  auto it = std::lower_bound(first, last, cell);
-  return (it != last && *it == cell) ? (int)(it - pair_cell_.begin()) : -1;
-}
-
 bool Assembly::same_layout(const sp_layout_view &l) const {
   return l.n_nodes == n_nodes_ && l.n_pairs == n_pairs_ && l.n_cells == n_cells_ &&
          std::equal(node_start_.begin(), node_start_.end(), l.node_start) &&
@@ -156,7 +144,8 @@ bool Assembly::same_layout(const sp_layout_view &l) const {
 
 void Assembly::gather(int e, const sp_step_data &d, const double *state,
                       Gathered &g) const {
-  const int nc = n_cells_on(e), s0 = elem_start_[e];
+  const int nc = n_cells_on(e);
+  const int64_t s0 = elem_start_[e];
   g.n_cells = nc;
   g.u.assign(8 * nc, 0.0);
   g.c_old.assign(4 * nc, 0.0);
@@ -307,7 +296,8 @@ sp_energy_parts Assembly::energy(const sp_model_params &m, const double *state) 
   agree_local(comm_, [&] {
     for (int e : my_elems_) {
       const ElementGeometry &geo = geometry_[e];
-      const int nc = n_cells_on(e), s0 = elem_start_[e];
+      const int nc = n_cells_on(e);
+      const int64_t s0 = elem_start_[e];
       for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
         double sum_sq = 0, sum_4 = 0;
         for (int j = 0; j < nc; ++j) {
@@ -375,7 +365,8 @@ void Assembly::shape_weights(const sp_step_data &d, std::vector<double> &u) cons
   agree_local(comm_, [&] {
     for (int e : my_elems_) {
       const ElementGeometry &geo = geometry_[e];
-      const int nc = n_cells_on(e), s0 = elem_start_[e];
+      const int nc = n_cells_on(e);
+      const int64_t s0 = elem_start_[e];
       for (int j = 0; j < nc; ++j) {
         const sp_shape_coef &sc = d.shape[slot_cell_[s0 + j]];
         const int *pairs = &slot_pair_[4 * (s0 + j)];

@@ -10,6 +10,7 @@
 #include <Epetra_Map.h>
 #include <Epetra_Vector.h>
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -57,8 +58,7 @@ class Assembly {
 
  private:
   struct Gathered;  // per-element scratch
-  int sp_layout_pair_of(int cell, int node) const;
-  int n_cells_on(int e) const { return elem_start_[e + 1] - elem_start_[e]; }
+  int n_cells_on(int e) const { return (int)(elem_start_[e + 1] - elem_start_[e]); }
   void gather(int e, const sp_step_data &data, const double *state,
               Gathered &g) const;
   void element_matrix(int e, const sp_step_data &data, const Gathered &g,
@@ -69,9 +69,11 @@ class Assembly {
   std::vector<int> node_start_, pair_cell_;
   std::vector<ElementGeometry> geometry_;
   std::vector<int> my_elems_;    // elements this rank assembles
-  std::vector<int> elem_start_;  // slots of element e: elem_start_[e]..[e+1]
+  // The element-slot table (sp_layout_view): slots of element e are
+  // elem_start_[e]..elem_start_[e+1]-1, 64-bit as 4 x slots can pass 2^31.
+  std::vector<int64_t> elem_start_;
   std::vector<int> slot_cell_;   // cell of each slot
-  std::vector<int> slot_pair_;   // 4 per slot: pair of (cell, node a) or -1
+  std::vector<int> slot_pair_;   // 4 per slot: pair of (cell, node a)
   std::unique_ptr<Epetra_Map> map_;
   std::unique_ptr<Epetra_CrsGraph> graph_;
 };

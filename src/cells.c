@@ -31,50 +31,59 @@ void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
   v2[1] = v1[0];
 }
 
+/** The shape functions at the Gauss points, N[q][b] (the same on every
+ *  element: Q1's reference values). */
+static void reference_shapes(double N[SP_Q1_QPOINTS][4]) {
+  for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+    double xi, eta, dN[4][2];
+    sp_q1_qpoint(q, &xi, &eta);
+    sp_q1_shape(xi, eta, N[q], dN);
+  }
+}
+
+/** The slot table of @p layout on @p mesh, and the mesh's Q1 geometry. */
+static int elements_of(const sp_mesh *mesh, const sp_layout *layout, const sp_slots **slots) {
+  SP_CHECK(layout->n_nodes == mesh->n_nodes && mesh->q1_w && mesh->q1_x, SP_ERR_INTERNAL,
+           "cells: %d nodes in the layout, %d in the mesh (or a mesh without its Q1 "
+           "geometry: made outside mesh.c)", layout->n_nodes, mesh->n_nodes);
+  return sp_layout_slots(layout, mesh, slots);
+}
+
 int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, double *w) {
-  SP_CHECK(k >= 0 && k < layout->n_cells && layout->n_nodes == mesh->n_nodes, SP_ERR_INTERNAL,
-           "node weights: cell %d of %d, %d nodes in the layout, %d in the mesh", k,
-           layout->n_cells, layout->n_nodes, mesh->n_nodes);
+  SP_CHECK(k >= 0 && k < layout->n_cells, SP_ERR_INTERNAL, "node weights: cell %d of %d", k,
+           layout->n_cells);
+  const sp_slots *t;
+  SP_CALL(elements_of(mesh, layout, &t));
+  double N[SP_Q1_QPOINTS][4];
+  reference_shapes(N);
   for (int i = 0; i < mesh->n_nodes; ++i) w[i] = 0.0;
   for (int e = 0; e < mesh->n_elems; ++e) {
     const int *nodes = mesh->elem + 4 * e;
-    int whole = 1;
-    for (int b = 0; b < 4 && whole; ++b) whole = sp_layout_pair(layout, k, nodes[b]) >= 0;
-    if (!whole) continue;
-    double xy[4][2];
-    sp_mesh_elem_xy(mesh, e, xy);
+    int64_t s = t->elem_start[e]; /* slots by increasing cell */
+    while (s < t->elem_start[e + 1] && t->slot_cell[s] < k) ++s;
+    if (s == t->elem_start[e + 1] || t->slot_cell[s] != k) continue;
     for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      double N[4], dNdx[4][2], x[2], wq;
-      sp_q1_point(xy, q, N, dNdx, x, &wq);
-      for (int b = 0; b < 4; ++b) w[nodes[b]] += wq * N[b];
+      const double wq = mesh->q1_w[SP_Q1_QPOINTS * (size_t)e + q];
+      for (int b = 0; b < 4; ++b) w[nodes[b]] += wq * N[q][b];
     }
   }
   return SP_OK;
 }
 
 int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *w) {
-  SP_CHECK(layout->n_nodes == mesh->n_nodes, SP_ERR_INTERNAL,
-           "pair weights: %d nodes in the layout, %d in the mesh", layout->n_nodes,
-           mesh->n_nodes);
+  const sp_slots *t;
+  SP_CALL(elements_of(mesh, layout, &t));
+  double N[SP_Q1_QPOINTS][4];
+  reference_shapes(N);
   for (int p = 0; p < layout->n_pairs; ++p) w[p] = 0.0;
-  for (int e = 0; e < mesh->n_elems; ++e) {
-    const int *nodes = mesh->elem + 4 * e;
-    double xy[4][2];
-    int have_xy = 0;
-    for (int p0 = layout->node_start[nodes[0]]; p0 < layout->node_start[nodes[0] + 1]; ++p0) {
-      const int k = layout->pair_cell[p0];
-      int pairs[4] = {p0, -1, -1, -1}, whole = 1;
-      for (int b = 1; b < 4 && whole; ++b) whole = (pairs[b] = sp_layout_pair(layout, k, nodes[b])) >= 0;
-      if (!whole) continue;
-      if (!have_xy) sp_mesh_elem_xy(mesh, e, xy);
-      have_xy = 1;
+  for (int e = 0; e < mesh->n_elems; ++e)
+    for (int64_t s = t->elem_start[e]; s < t->elem_start[e + 1]; ++s) {
+      const int *pairs = t->slot_pair + 4 * (size_t)s;
       for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-        double N[4], dNdx[4][2], x[2], wq;
-        sp_q1_point(xy, q, N, dNdx, x, &wq);
-        for (int b = 0; b < 4; ++b) w[pairs[b]] += wq * N[b];
+        const double wq = mesh->q1_w[SP_Q1_QPOINTS * (size_t)e + q];
+        for (int b = 0; b < 4; ++b) w[pairs[b]] += wq * N[q][b];
       }
     }
-  }
   return SP_OK;
 }
 
@@ -82,26 +91,23 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
                      const double *state, double weight_threshold,
                      sp_cell_obs *obs) {
   const int nc = layout->n_cells;
+  const sp_slots *t;
+  SP_CALL(elements_of(mesh, layout, &t));
+  double N[SP_Q1_QPOINTS][4];
+  reference_shapes(N);
   /* Per cell: mass, weighted mass, first and second moments, area. */
   double *sums;
   SP_ALLOC(sums, 8 * (size_t)nc);
   for (int e = 0; e < mesh->n_elems; ++e) {
-    double xy[4][2];
-    sp_mesh_elem_xy(mesh, e, xy);
-    const int *nodes = mesh->elem + 4 * e;
     for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      double N[4], dNdx[4][2], x[2], w;
-      sp_q1_point(xy, q, N, dNdx, x, &w);
-      /* Cell k lives on the element when all four nodes carry it (the
-       * solver's rule: a field's domain is a union of whole elements). */
-      for (int p0 = layout->node_start[nodes[0]]; p0 < layout->node_start[nodes[0] + 1]; ++p0) {
-        const int k = layout->pair_cell[p0];
-        int pairs[4] = {p0, -1, -1, -1}, whole = 1;
-        for (int b = 1; b < 4 && whole; ++b) whole = (pairs[b] = sp_layout_pair(layout, k, nodes[b])) >= 0;
-        if (!whole) continue;
+      const size_t eq = SP_Q1_QPOINTS * (size_t)e + q;
+      const double w = mesh->q1_w[eq], *x = mesh->q1_x + 2 * eq;
+      /* the cells living on the element (the slot table's rule) */
+      for (int64_t slot = t->elem_start[e]; slot < t->elem_start[e + 1]; ++slot) {
+        const int *pairs = t->slot_pair + 4 * (size_t)slot;
         double c = 0;
-        for (int b = 0; b < 4; ++b) c += N[b] * state[2 * pairs[b]];
-        double *s = sums + 8 * k;
+        for (int b = 0; b < 4; ++b) c += N[q][b] * state[2 * pairs[b]];
+        double *s = sums + 8 * t->slot_cell[slot];
         s[0] += w * c;
         if (c >= 0.5) s[7] += w;
         const double cw = c >= weight_threshold ? c : 0.0;

@@ -14,6 +14,7 @@
 #define SP_LAYOUT_H
 
 #include <limits.h>
+#include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -40,13 +41,49 @@ static inline long long sp_nonzeros_bound(long long n_nodes, long long n_i) {
   return 9 * n_nodes * n_i * (n_i + 3);
 }
 
+struct sp_mesh;
+
+/** Tables derived from a layout (layout.c), built on first use, freed with it. */
+typedef struct sp_layout_cache sp_layout_cache;
+
 typedef struct sp_layout {
   int n_nodes;
   int n_cells;
   int n_pairs;
   int *node_start; /**< n_nodes + 1 offsets into pair_cell */
   int *pair_cell;  /**< cell of each pair */
+  sp_layout_cache *cache; /**< derived tables (sp_layout_slots, sp_layout_cells) */
 } sp_layout;
+
+/**
+ * The element-slot table of a layout on a mesh: the one place where the
+ * rule "cell k lives on element e only if all four of its nodes carry k"
+ * is applied (a field's domain is then a union of whole elements, with a
+ * natural no-flux boundary). CSR by element: element e's slots are
+ * elem_start[e] .. elem_start[e+1]-1, by increasing cell; slot s is cell
+ * slot_cell[s] on the element, with the pair of its local node a at
+ * slot_pair[4 s + a] (never -1). Offsets are 64-bit: slots x 4 can pass
+ * 2^31 where pairs cannot.
+ */
+typedef struct sp_slots {
+  int n_elems;
+  int64_t n_slots;
+  int64_t *elem_start; /**< n_elems + 1 */
+  int *slot_cell;      /**< n_slots */
+  int *slot_pair;      /**< 4 n_slots */
+} sp_slots;
+
+/**
+ * Each cell's pairs, cell-major (the transpose of the node-major numbering):
+ * cell k's are cell_start[k] .. cell_start[k+1]-1, by increasing node, pair
+ * cell_pair[j] at node cell_node[j]. Walks over one cell's support cost its
+ * pairs, not the mesh's nodes.
+ */
+typedef struct sp_cell_pairs {
+  int64_t *cell_start; /**< n_cells + 1 */
+  int *cell_node;      /**< n_pairs */
+  int *cell_pair;      /**< n_pairs */
+} sp_cell_pairs;
 
 /** @brief Every cell supported on every node (the paper's method). */
 int sp_layout_create_full(int n_nodes, int n_cells, sp_layout **out);
@@ -63,6 +100,31 @@ int sp_layout_create_from_masks(int n_nodes, int n_cells,
 
 /** @brief sp_nonzeros_bound summed over the layout's nodes. */
 long long sp_layout_nonzeros_bound(const sp_layout *layout);
+
+/**
+ * @brief A layout from per-cell node lists: cell k's support is the nodes
+ *        cell_node[cell_start[k] .. cell_start[k+1]-1] (no repeats, any
+ *        order). O(pairs + nodes); the same layout as from the masks.
+ * @return SP_OK, or SP_ERR_MEMORY as sp_layout_create_from_masks
+ */
+int sp_layout_create_from_lists(int n_nodes, int n_cells, const int64_t *cell_start,
+                                const int *cell_node, sp_layout **out);
+
+/** @brief @p layout with one more cell, n_cells, on @p parent's support
+ *         (a division: the child starts where its parent is). O(pairs). */
+int sp_layout_with_child(const sp_layout *layout, int parent, sp_layout **out);
+
+/**
+ * @brief The element-slot table of @p layout on @p mesh (sp_slots), built
+ *        on the first call and kept with the layout (a new mesh rebuilds it).
+ * @param[out] out borrowed: valid while the layout lives
+ */
+int sp_layout_slots(const sp_layout *layout, const struct sp_mesh *mesh,
+                    const sp_slots **out);
+
+/** @brief The cell-major pairs of @p layout (sp_cell_pairs), built on the
+ *         first call and kept with it. @param[out] out borrowed */
+int sp_layout_cells(const sp_layout *layout, const sp_cell_pairs **out);
 
 /** @brief The pair of (cell, node), or -1 if node is outside the support. */
 int sp_layout_pair(const sp_layout *layout, int cell, int node);

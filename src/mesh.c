@@ -64,7 +64,9 @@ static int mesh_allocate(int n_nodes, int n_elems, sp_mesh **out) {
   mesh->xy = calloc((size_t)2 * n_nodes, sizeof *mesh->xy);
   mesh->elem = calloc((size_t)4 * n_elems, sizeof *mesh->elem);
   mesh->region = calloc((size_t)n_elems, sizeof *mesh->region);
-  if (!mesh->xy || !mesh->elem || !mesh->region) {
+  mesh->q1_w = calloc((size_t)SP_Q1_QPOINTS * n_elems, sizeof *mesh->q1_w);
+  mesh->q1_x = calloc((size_t)2 * SP_Q1_QPOINTS * n_elems, sizeof *mesh->q1_x);
+  if (!mesh->xy || !mesh->elem || !mesh->region || !mesh->q1_w || !mesh->q1_x) {
     sp_mesh_destroy(&mesh);
     return sp_error_set(SP_ERR_MEMORY, "out of memory allocating a mesh of "
                         "%d nodes and %d elements", n_nodes, n_elems);
@@ -73,12 +75,18 @@ static int mesh_allocate(int n_nodes, int n_elems, sp_mesh **out) {
   return SP_OK;
 }
 
-/** The largest element edge length (sets mesh->h). */
-static void mesh_set_h(sp_mesh *mesh) {
+/** The largest element edge length (sets mesh->h) and the Q1 geometry at
+ *  the Gauss points (mesh->q1_w, q1_x), once the nodes are final. */
+static void mesh_finish(sp_mesh *mesh) {
   double h2 = 0;
   for (int e = 0; e < mesh->n_elems; ++e) {
     double xy[4][2];
     sp_mesh_elem_xy(mesh, e, xy);
+    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+      const size_t eq = (size_t)SP_Q1_QPOINTS * e + q;
+      double N[4], dNdx[4][2];
+      sp_q1_point(xy, q, N, dNdx, mesh->q1_x + 2 * eq, mesh->q1_w + eq);
+    }
     for (int a = 0; a < 4; ++a) {
       double dx = xy[(a + 1) % 4][0] - xy[a][0];
       double dy = xy[(a + 1) % 4][1] - xy[a][1];
@@ -139,7 +147,7 @@ int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
   mesh->bounds[1] = y0;
   mesh->bounds[2] = x1;
   mesh->bounds[3] = y1;
-  mesh_set_h(mesh);
+  mesh_finish(mesh);
   *out = mesh;
   return SP_OK;
 }
@@ -410,7 +418,7 @@ int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
   mesh->bounds[1] = 0;
   mesh->bounds[2] = a;
   mesh->bounds[3] = b;
-  mesh_set_h(mesh);
+  mesh_finish(mesh);
   *out = mesh;
   return SP_OK;
 }
@@ -452,6 +460,8 @@ void sp_mesh_destroy(sp_mesh **mesh) {
   free((*mesh)->xy);
   free((*mesh)->elem);
   free((*mesh)->region);
+  free((*mesh)->q1_w);
+  free((*mesh)->q1_x);
   free(*mesh);
   *mesh = NULL;
 }

@@ -22,6 +22,11 @@ typedef struct sp_mesh {
   int is_ellipse;   /**< 1 for the ellipse mesh, 0 for a rectangle */
   double bounds[4]; /**< Omega: rectangle x0, y0, x1, y1; ellipse 0, 0, a, b */
   double h;         /**< largest element edge length */
+  /** The Q1 geometry at element e's Gauss point q (sp_q1_point), made once
+   *  with the mesh so that loops over elements (src/cells.c) need not
+   *  recompute it: the weight |det J| at [4 e + q], the point at
+   *  [2 (4 e + q)] and [2 (4 e + q) + 1]. NULL in a mesh not made here. */
+  double *q1_w, *q1_x;
 } sp_mesh;
 
 /**

@@ -77,8 +77,15 @@ int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *lay
   SP_ALLOC(first_node, (size_t)n_ranks + 1);
   sp_partition_ranges(layout, n_ranks, first_node);
   sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
+  const sp_slots *slots; /* the element-slot table: the glue's too */
+  const int rc = sp_layout_slots(layout, mesh, &slots);
+  if (rc != SP_OK) {
+    free(first_node);
+    return rc;
+  }
   sp_layout_view lv = {layout->n_nodes, layout->n_cells, layout->n_pairs, layout->node_start,
-                       layout->pair_cell, first_node, n_ranks};
+                       layout->pair_cell, first_node, n_ranks, slots->n_slots,
+                       slots->elem_start, slots->slot_cell, slots->slot_pair};
   const int status = sp_solver_set_problem(solver, &mv, &lv);
   free(first_node);
   if (status != SP_SOLVER_OK) return sp_solver_failed(solver, status, "solver setup");
@@ -275,14 +282,7 @@ static int update_supports(sp_run *run, sp_energy_parts *after) {
 static int layout_with_child(sp_run *run, int parent, sp_layout **out) {
   const int n = run->layout->n_cells, nn = run->mesh->n_nodes;
   if (!run->support) return sp_layout_create_full(nn, n + 1, out);
-  unsigned char *mask;
-  SP_ALLOC(mask, (size_t)nn * (n + 1));
-  for (int k = 0; k <= n; ++k)
-    for (int i = 0; i < nn; ++i)
-      mask[(size_t)k * nn + i] = sp_layout_pair(run->layout, k < n ? k : parent, i) >= 0;
-  int rc = sp_layout_create_from_masks(nn, n + 1, mask, out);
-  free(mask);
-  return rc;
+  return sp_layout_with_child(run->layout, parent, out);
 }
 
 /**

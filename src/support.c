@@ -16,7 +16,18 @@ struct sp_support_s {
   int *source, *queue;
   double *best;
   unsigned char *in_set;
+  /* scratch marks, n_nodes each, all 0 between calls: a candidate support
+   * and the nodes of its whole elements (closing a support) */
+  unsigned char *member, *kept;
 };
+
+/** Per-cell node lists being built (CSR: cell k's nodes are
+ *  node[start[k] .. start[k+1]-1]); grown by doubling. */
+typedef struct {
+  int64_t *start;
+  int *node;
+  int64_t cap;
+} cell_lists;
 
 int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_support *out) {
   SP_CHECK(params->margin > 0 && params->band > 0 && params->band < params->margin,
@@ -34,6 +45,8 @@ int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_s
   SP_ALLOC(s->queue, nn);
   SP_ALLOC(s->best, nn);
   SP_ALLOC(s->in_set, nn);
+  SP_ALLOC(s->member, nn);
+  SP_ALLOC(s->kept, nn);
   for (int e = 0; e < ne; ++e)
     for (int a = 0; a < 4; ++a) ++s->ne_start[mesh->elem[4 * e + a] + 1];
   for (int i = 0; i < nn; ++i) s->ne_start[i + 1] += s->ne_start[i];
@@ -57,6 +70,8 @@ void sp_support_destroy(sp_support *s) {
   free((*s)->queue);
   free((*s)->best);
   free((*s)->in_set);
+  free((*s)->member);
+  free((*s)->kept);
   free(*s);
   *s = NULL;
 }
@@ -105,47 +120,137 @@ static void clear_set(sp_support s, int n) {
   for (int q = 0; q < n; ++q) s->in_set[s->queue[q]] = 0;
 }
 
+/**
+ * Cell k's support computed from its field, into s->queue[0..return): the
+ * nodes within the margin of its core (c_k >= core threshold), or the
+ * support it has when the core is empty (so it cannot vanish). Costs cell
+ * k's pairs and the nodes reached, not the mesh's nodes.
+ */
+static int computed_support(sp_support s, const sp_cell_pairs *cp, const double *state, int k) {
+  int n_seeds = 0; /* seeds by increasing node, as the search expects */
+  for (int64_t j = cp->cell_start[k]; j < cp->cell_start[k + 1]; ++j)
+    if (state[2 * cp->cell_pair[j]] >= s->params.core_threshold)
+      s->queue[n_seeds++] = cp->cell_node[j];
+  if (n_seeds == 0) {
+    int n = 0;
+    for (int64_t j = cp->cell_start[k]; j < cp->cell_start[k + 1]; ++j)
+      s->queue[n++] = cp->cell_node[j];
+    return n;
+  }
+  const int reached = grow_from_seeds(s, n_seeds, s->params.margin, NULL);
+  clear_set(s, reached);
+  return reached;
+}
+
+/** Mark s->queue[0..n) in s->member; returns n. */
+static int mark_members(sp_support s, int n) {
+  for (int q = 0; q < n; ++q) s->member[s->queue[q]] = 1;
+  return n;
+}
+
+/** Append node @p i to cell list @p L (the cell being built is the last). */
+static int lists_push(cell_lists *L, int n_cells_done, int i) {
+  const int64_t len = L->start[n_cells_done + 1];
+  if (len == L->cap) {
+    const int64_t cap = L->cap ? 2 * L->cap : 1024;
+    int *grown = realloc(L->node, sizeof(int) * (size_t)cap);
+    if (!grown) return sp_error_set(SP_ERR_MEMORY, "supports: out of memory for %lld nodes",
+                                    (long long)cap);
+    L->node = grown;
+    L->cap = cap;
+  }
+  L->node[len] = i;
+  L->start[n_cells_done + 1] = len + 1;
+  return SP_OK;
+}
+
+/**
+ * Close the candidate support s->queue[0..n) (marked in s->member) to whole
+ * elements, the solver's rule: its nodes that belong to an element whose
+ * four nodes are all candidates. They are appended to @p L as cell
+ * @p k's list; the marks are cleared. Costs the candidates' elements.
+ */
+static int close_to_elements(sp_support s, int n, int k, cell_lists *L) {
+  const sp_mesh *m = s->mesh;
+  int rc = SP_OK;
+  L->start[k + 1] = L->start[k];
+  for (int q = 0; q < n && rc == SP_OK; ++q)
+    for (int t = s->ne_start[s->queue[q]]; t < s->ne_start[s->queue[q] + 1]; ++t) {
+      const int *nodes = m->elem + 4 * s->ne_list[t];
+      if (!(s->member[nodes[0]] && s->member[nodes[1]] && s->member[nodes[2]] &&
+            s->member[nodes[3]]))
+        continue;
+      for (int a = 0; a < 4 && rc == SP_OK; ++a)
+        if (!s->kept[nodes[a]]) {
+          s->kept[nodes[a]] = 1;
+          rc = lists_push(L, k, nodes[a]);
+        }
+    }
+  for (int q = 0; q < n; ++q) s->member[s->queue[q]] = s->kept[s->queue[q]] = 0;
+  return rc;
+}
+
+static void lists_free(cell_lists *L) {
+  free(L->start);
+  free(L->node);
+}
+
 int sp_support_masks(sp_support s, const sp_layout *layout, const double *state,
                      unsigned char *mask) {
   const int nn = s->mesh->n_nodes;
+  const sp_cell_pairs *cp;
+  SP_CALL(sp_layout_cells(layout, &cp));
+  /* (cells x nodes bytes: the set-up's interface, not a step's) */
   memset(mask, 0, (size_t)nn * layout->n_cells);
   for (int k = 0; k < layout->n_cells; ++k) {
-    unsigned char *mk = mask + (size_t)k * nn;
-    int n_seeds = 0;
-    for (int i = 0; i < nn; ++i) {
-      int p = sp_layout_pair(layout, k, i);
-      if (p >= 0 && state[2 * p] >= s->params.core_threshold) s->queue[n_seeds++] = i;
-    }
-    if (n_seeds == 0) { /* no core: keep the support it has */
-      for (int i = 0; i < nn; ++i) mk[i] = sp_layout_pair(layout, k, i) >= 0;
-      continue;
-    }
-    int reached = grow_from_seeds(s, n_seeds, s->params.margin, NULL);
-    for (int q = 0; q < reached; ++q) mk[s->queue[q]] = 1;
-    clear_set(s, reached);
+    const int n = computed_support(s, cp, state, k);
+    for (int q = 0; q < n; ++q) mask[(size_t)k * nn + s->queue[q]] = 1;
   }
   return SP_OK;
 }
 
 int sp_support_layout_from_masks(sp_support s, int n_cells, unsigned char *mask,
                                  sp_layout **out) {
-  /* Keep only nodes of whole elements of each cell (the solver's rule). */
-  const sp_mesh *m = s->mesh;
-  const int nn = m->n_nodes;
-  unsigned char *kept;
-  SP_ALLOC(kept, nn);
-  for (int k = 0; k < n_cells; ++k) {
+  const int nn = s->mesh->n_nodes;
+  cell_lists L = {0};
+  L.start = calloc((size_t)n_cells + 1, sizeof *L.start);
+  int rc = L.start ? SP_OK : sp_error_set(SP_ERR_MEMORY, "supports: out of memory");
+  for (int k = 0; k < n_cells && rc == SP_OK; ++k) {
     unsigned char *mk = mask + (size_t)k * nn;
-    memset(kept, 0, nn);
-    for (int e = 0; e < m->n_elems; ++e) {
-      const int *nodes = m->elem + 4 * e;
-      if (mk[nodes[0]] && mk[nodes[1]] && mk[nodes[2]] && mk[nodes[3]])
-        for (int a = 0; a < 4; ++a) kept[nodes[a]] = 1;
-    }
-    memcpy(mk, kept, nn);
+    int n = 0;
+    for (int i = 0; i < nn; ++i)
+      if (mk[i]) s->queue[n++] = i;
+    rc = close_to_elements(s, mark_members(s, n), k, &L);
+    /* the mask closed, as the caller may read it */
+    memset(mk, 0, (size_t)nn);
+    for (int64_t j = L.start[k]; j < L.start[k + 1] && rc == SP_OK; ++j) mk[L.node[j]] = 1;
   }
-  free(kept);
-  return sp_layout_create_from_masks(nn, n_cells, mask, out);
+  if (rc == SP_OK) rc = sp_layout_create_from_lists(nn, n_cells, L.start, L.node, out);
+  lists_free(&L);
+  return rc;
+}
+
+int sp_support_layout(sp_support s, const sp_layout *layout, const double *state,
+                      const unsigned char *may_shrink, sp_layout **out) {
+  const int nc = layout->n_cells;
+  const sp_cell_pairs *cp;
+  SP_CALL(sp_layout_cells(layout, &cp));
+  cell_lists L = {0};
+  L.start = calloc((size_t)nc + 1, sizeof *L.start);
+  int rc = L.start ? SP_OK : sp_error_set(SP_ERR_MEMORY, "supports: out of memory");
+  for (int k = 0; k < nc && rc == SP_OK; ++k) {
+    int n = mark_members(s, computed_support(s, cp, state, k));
+    if (may_shrink && !may_shrink[k]) /* the union with the support it has */
+      for (int64_t j = cp->cell_start[k]; j < cp->cell_start[k + 1]; ++j)
+        if (!s->member[cp->cell_node[j]]) {
+          s->member[cp->cell_node[j]] = 1;
+          s->queue[n++] = cp->cell_node[j];
+        }
+    rc = close_to_elements(s, n, k, &L);
+  }
+  if (rc == SP_OK) rc = sp_layout_create_from_lists(layout->n_nodes, nc, L.start, L.node, out);
+  lists_free(&L);
+  return rc;
 }
 
 /** Node i of cell k's support is on its edge: an element around it is not
@@ -161,26 +266,29 @@ static int on_edge(sp_support s, const sp_layout *layout, int k, int i) {
 
 int sp_support_needs_update(sp_support s, const sp_layout *layout, const double *state,
                             int *needed) {
-  const int nn = s->mesh->n_nodes;
   *needed = 0;
-  unsigned char *allowed;
+  const sp_cell_pairs *cp;
   /* (a failure is an error, not "rebuild": every rank must decide alike) */
-  SP_ALLOC(allowed, (size_t)nn);
+  SP_CALL(sp_layout_cells(layout, &cp));
   int grow = 0;
   for (int k = 0; k < layout->n_cells && !grow; ++k) {
+    /* the search stays in cell k's support, from its edge (by increasing
+     * node): cell k's pairs, not the mesh's nodes */
+    const int64_t j0 = cp->cell_start[k], j1 = cp->cell_start[k + 1];
     int n_seeds = 0;
-    for (int i = 0; i < nn; ++i) {
-      allowed[i] = sp_layout_pair(layout, k, i) >= 0;
-      if (allowed[i] && on_edge(s, layout, k, i)) s->queue[n_seeds++] = i;
+    for (int64_t j = j0; j < j1; ++j) {
+      const int i = cp->cell_node[j];
+      s->member[i] = 1;
+      if (on_edge(s, layout, k, i)) s->queue[n_seeds++] = i;
     }
-    int reached = grow_from_seeds(s, n_seeds, s->params.band, allowed);
+    int reached = grow_from_seeds(s, n_seeds, s->params.band, s->member);
     for (int q = 0; q < reached && !grow; ++q) {
       int p = sp_layout_pair(layout, k, s->queue[q]);
       grow = state[2 * p] >= s->params.grow_threshold;
     }
     clear_set(s, reached);
+    for (int64_t j = j0; j < j1; ++j) s->member[cp->cell_node[j]] = 0;
   }
-  free(allowed);
   *needed = grow;
   return SP_OK;
 }
@@ -206,16 +314,8 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   *new_state = NULL;
   *mass_correction = 0;
   *mass_dropped = 0;
-  unsigned char *mask;
-  SP_ALLOC(mask, (size_t)nn * (nc ? nc : 1));
-  int rc = sp_support_masks(s, layout, state, mask);
-  for (int k = 0; k < nc && rc == SP_OK; ++k)
-    if (may_shrink && !may_shrink[k])
-      for (int i = 0; i < nn; ++i)
-        if (sp_layout_pair(layout, k, i) >= 0) mask[(size_t)k * nn + i] = 1;
-  if (rc == SP_OK) rc = sp_support_layout_from_masks(s, nc, mask, new_layout);
-  free(mask);
-  SP_CALL(rc);
+  SP_CALL(sp_support_layout(s, layout, state, may_shrink, new_layout));
+  int rc = SP_OK;
   sp_layout *to = *new_layout;
   double *next;
   SP_ALLOC(next, 2 * (size_t)to->n_pairs);
