@@ -8,6 +8,14 @@
  *  2. Newton iterations and assembly seconds per step for ad, hand and fd on
  *     3 steps of a 4-cell scene at dt = 1e-5.
  *
+ * Both parts start from a scene text set up as a run is (sp_run_setup,
+ * run_setup.h: RCB node numbering, the scene's solver keys, layout.support
+ * full): n disks on a sunflower spiral, the run's initial profile and
+ * seeded background noise. (Before issue 19 the bench built the mesh,
+ * layout and tanh disks by hand, in the mesh's own numbering: figures in
+ * docs/jacobians.md measured before then come from that state, which was
+ * the same up to the noise's draws and the numbering.)
+ *
  *   OMP_NUM_THREADS=1 ./bench/bench_jacobians [repeat_scale] [timing|newton]
  *
  * repeat_scale (default 1) multiplies the repeats (fd is capped at 1
@@ -18,60 +26,53 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
 #include "error.h"
-#include "layout.h"
-#include "mesh.h"
+#include "run_setup.h"
 #include "softpack_solver.h"
-#include "stepper.h"
 
-static sp_model_params paper_model(void) {
-  sp_model_params m = {.alpha = 4, .kappa = 1e-3, .lambda = 100, .lambda_b = 100,
-                       .mobility = 1};
-  return m;
-}
-
-static sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout, int jacobian) {
-  sp_solver_options opt = {.jacobian = jacobian, .linear = SP_SOLVER_SUPERLU,
-                           .newton_rtol = 1e-10, .newton_atol = 1e-11, .newton_max_its = 20};
-  sp_solver s = NULL;
-  if (sp_solver_create(MPI_COMM_WORLD, &opt, &s) != 0) {
-    fprintf(stderr, "sp_solver_create: %s\n", sp_solver_last_error(s));
-    exit(1);
-  }
-  if (sp_solver_attach(s, mesh, layout) != SP_OK) {
-    fprintf(stderr, "%s\n", sp_error_message());
-    exit(1);
-  }
-  return s;
-}
-
-/* n tanh disks on a sunflower spiral inside the ellipse (semi-axes a, b),
- * radius 0.45 of the closest centre distance (near neighbours almost
- * touch, none overlap); a small seeded background. */
-static void spread_disks(const sp_mesh *mesh, const sp_layout *layout, int n, double a,
-                         double b, double *state) {
-  const double d = sqrt(1e-3 / 8), golden = 2.39996322972865332;
+/** A scene of @p n disks on a sunflower spiral inside the ellipse (semi-axes
+ *  0.5, 0.25), radius 0.45 of the closest centre distance (near neighbours
+ *  almost touch, none overlap; 0.12 alone), a small seeded background; the
+ *  paper's model, Newton with the Jacobian @p jacobian ("ad", "hand",
+ *  "fd") from scratch every iteration; set up in @p run (exits on
+ *  failure). */
+static sp_scene *disks_run(int n, const char *jacobian, sp_run *run) {
+  const double golden = 2.39996322972865332;
   double x[64], y[64], closest = 1e300;
   for (int k = 0; k < n && k < 64; ++k) {
     const double r = n == 1 ? 0.0 : 0.7 * sqrt((k + 0.5) / n);
-    x[k] = a * r * cos(k * golden);
-    y[k] = b * r * sin(k * golden);
+    x[k] = 0.5 * r * cos(k * golden);
+    y[k] = 0.25 * r * sin(k * golden);
     for (int l = 0; l < k; ++l) closest = fmin(closest, hypot(x[k] - x[l], y[k] - y[l]));
   }
   const double R = n == 1 ? 0.12 : 0.45 * closest;
-  unsigned long long rng = 12345;
-  for (int k = 0; k < n && k < 64; ++k) {
-    const double xk = x[k], yk = y[k];
-    for (int i = 0; i < mesh->n_nodes; ++i) {
-      int p = sp_layout_pair(layout, k, i);
-      if (p < 0) continue;
-      double dist = hypot(mesh->xy[2 * i] - xk, mesh->xy[2 * i + 1] - yk);
-      double prof = 1.0 / (1.0 + exp((dist - R) / d));
-      state[2 * p] = prof + (1 - prof) * (0.02 + 0.01 * sp_random_symmetric(&rng));
-      state[2 * p + 1] = 0.0;
-    }
+  char text[8192];
+  int len = snprintf(text, sizeof text,
+                     "mesh: {type: ellipse, refinements: 5, semi_x: 0.5, semi_y: 0.25, "
+                     "buffer_layers: 0}\n"
+                     "model: {alpha: 4, kappa: 1.0e-3, lambda: 100, lambda_b: 100, mobility: 1}\n"
+                     "time: {dt: 1.0e-5}\n"
+                     "noise: {background: 0.02, amplitude: 0.01, seed: 12345}\n"
+                     "layout: {support: full}\n"
+                     "solver: {linear: superlu, jacobian: %s, newton_rtol: 1.0e-10, "
+                     "newton_atol: 1.0e-11, newton_max_its: 20, jacobian_reuse: 0}\n"
+                     "cells:\n", jacobian);
+  for (int k = 0; k < n && k < 64; ++k)
+    len += snprintf(text + len, sizeof text - len, "  - {x: %.17g, y: %.17g, radius: %.17g}\n",
+                    x[k], y[k], R);
+  sp_scene *scene = NULL;
+  *run = (sp_run){0};
+  if (sp_scene_load_text("bench_jacobians", text, (size_t)len, 0, NULL, &scene) != SP_OK ||
+      sp_run_setup(run, scene, MPI_COMM_WORLD, NULL) != SP_OK) {
+    fprintf(stderr, "%s\n", sp_error_message());
+    exit(1);
   }
+  return scene;
+}
+
+static void disks_free(sp_scene **scene, sp_run *run) {
+  sp_run_free(run);
+  sp_scene_destroy(scene);
 }
 
 static const char *kind_name(int kind, int n_cells) {
@@ -83,15 +84,14 @@ static const char *kind_name(int kind, int n_cells) {
   }
 }
 
-static void time_kinds(const sp_mesh *mesh, int n_cells, int scale) {
-  sp_layout *layout;
-  if (sp_layout_create_full(mesh->n_nodes, n_cells, &layout) != SP_OK) exit(1);
-  sp_solver s = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
-  const int n = 2 * layout->n_pairs;
-  double *state = calloc(n, sizeof(double)), *old = calloc(n, sizeof(double));
-  spread_disks(mesh, layout, n_cells, 0.5, 0.25, state);
-  memcpy(old, state, n * sizeof(double));
-  sp_step_data data = {.dt = 1e-5, .model = paper_model(), .state_old = old};
+static void time_kinds(int n_cells, int scale) {
+  sp_run run;
+  sp_scene *scene = disks_run(n_cells, "ad", &run);
+  const sp_solver s = run.solver;
+  const int n = 2 * run.layout->n_pairs;
+  const double *state = run.state;
+  memcpy(run.state_old, state, n * sizeof(double));
+  sp_step_data data = {.dt = 1e-5, .model = run.model, .state_old = run.state_old};
   /* hand first: the ratios are to it. ad at 16 cells is DFad already. */
   int kinds[4] = {SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_AD_DFAD, SP_SOLVER_JAC_FD};
   int base = n_cells == 1 ? 20 : n_cells == 4 ? 6 : 2;
@@ -116,34 +116,27 @@ static void time_kinds(const sp_mesh *mesh, int n_cells, int scale) {
            elem / t_hand_elem);
     fflush(stdout);
   }
-  sp_solver_destroy(&s);
-  sp_layout_destroy(&layout);
-  free(state);
-  free(old);
+  disks_free(&scene, &run);
 }
 
-static void newton_kinds(const sp_mesh *mesh) {
+static void newton_kinds(void) {
   const int n_cells = 4, steps = 3;
-  sp_layout *layout;
-  if (sp_layout_create_full(mesh->n_nodes, n_cells, &layout) != SP_OK) exit(1);
-  const int n = 2 * layout->n_pairs;
-  double *init = calloc(n, sizeof(double));
-  spread_disks(mesh, layout, n_cells, 0.5, 0.25, init);
   int kinds[3] = {SP_SOLVER_JAC_AD, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD};
+  const char *words[3] = {"ad", "hand", "fd"};
   for (int k = 0; k < 3; ++k) {
-    sp_solver s = make_solver(mesh, layout, kinds[k]);
-    double *state = malloc(n * sizeof(double)), *old = malloc(n * sizeof(double));
-    memcpy(state, init, n * sizeof(double));
+    sp_run run;
+    sp_scene *scene = disks_run(n_cells, words[k], &run);
+    const int n = 2 * run.layout->n_pairs;
     printf("| %-9s |", kind_name(kinds[k], n_cells));
     double t_asm = 0, t_fac = 0, t_tot = 0;
     int its = 0;
     for (int step = 0; step < steps; ++step) {
-      memcpy(old, state, n * sizeof(double));
-      sp_step_data data = {.dt = 1e-5, .model = paper_model(), .state_old = old};
+      memcpy(run.state_old, run.state, n * sizeof(double));
+      sp_step_data data = {.dt = 1e-5, .model = run.model, .state_old = run.state_old};
       sp_step_report rep;
-      int rc = sp_solver_step(s, &data, state, &rep);
+      int rc = sp_solver_step(run.solver, &data, run.state, &rep);
       if (rc != 0) {
-        printf(" step %d failed: %s |", step + 1, sp_solver_last_error(s));
+        printf(" step %d failed: %s |", step + 1, sp_solver_last_error(run.solver));
         break;
       }
       printf(" %d", rep.newton_its);
@@ -154,24 +147,20 @@ static void newton_kinds(const sp_mesh *mesh) {
     }
     printf(" | %d | %.3f | %.3f | %.3f |\n", its, t_asm / steps, t_fac / steps, t_tot / steps);
     fflush(stdout);
-    sp_solver_destroy(&s);
-    free(state);
-    free(old);
+    disks_free(&scene, &run);
   }
-  sp_layout_destroy(&layout);
-  free(init);
 }
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   int scale = argc > 1 ? atoi(argv[1]) : 1;
   if (scale < 1) scale = 1;
-  sp_mesh *mesh;
-  if (sp_mesh_ellipse(5, 0.5, 0.25, 0, 0, &mesh) != SP_OK) {
-    fprintf(stderr, "%s\n", sp_error_message());
-    return 1;
+  {
+    sp_run run;
+    sp_scene *scene = disks_run(1, "ad", &run);
+    printf("ellipse: %d nodes, %d elements\n\n", run.mesh->n_nodes, run.mesh->n_elems);
+    disks_free(&scene, &run);
   }
-  printf("ellipse: %d nodes, %d elements\n\n", mesh->n_nodes, mesh->n_elems);
   const int cells[3] = {1, 4, 16};
   const char *part = argc > 2 ? argv[2] : "all";
   if (strcmp(part, "newton") != 0) {
@@ -180,10 +169,9 @@ int main(int argc, char **argv) {
     printf("| cells | unknowns | kind | repeats | fill s | / hand | elements s | / hand |\n");
     printf("|---|---|---|---|---|---|---|---|\n");
     fflush(stdout);
-    for (int c = 0; c < 3; ++c) time_kinds(mesh, cells[c], scale);
+    for (int c = 0; c < 3; ++c) time_kinds(cells[c], scale);
   }
   if (strcmp(part, "timing") == 0) {
-    sp_mesh_destroy(&mesh);
     MPI_Finalize();
     return 0;
   }
@@ -193,8 +181,7 @@ int main(int argc, char **argv) {
          " | step s |\n");
   printf("|---|---|---|---|---|---|\n");
   fflush(stdout);
-  newton_kinds(mesh);
-  sp_mesh_destroy(&mesh);
+  newton_kinds();
   MPI_Finalize();
   return 0;
 }

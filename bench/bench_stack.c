@@ -6,6 +6,10 @@
  * each cell's c at the final time to the next finer mesh (nested meshes: the
  * fine solution is read at the coarse nodes; discrete L2 norm over the
  * coarse mesh).
+ * The mesh, full layout and state are built by hand, not with the run's
+ * set-up (run_setup.h): the L2 comparison reads each field at the nested
+ * rectangles' natural node numbering, which the set-up's RCB renumbering
+ * would scramble.
  *   build/bench/bench_stack [steps=5] [dt=1e-5] [n1 n2 ...]
  */
 #include <math.h>

@@ -145,6 +145,13 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
   return SP_OK;
 }
 
+void sp_cells_core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out) {
+  for (int k = 0; k < n; ++k) {
+    out[k] = obs[k];
+    out[k].mass = obs[k].mass_core;
+  }
+}
+
 double sp_random_symmetric(unsigned long long *rng) {
   unsigned long long z = (*rng += 0x9E3779B97F4A7C15ULL);
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;

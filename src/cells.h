@@ -41,6 +41,10 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
                      const double *state, double weight_threshold,
                      sp_cell_obs *obs);
 
+/** @brief @p obs with the mass replaced by the core mass (c >= the
+ *         threshold): what division and source decisions see. */
+void sp_cells_core_view(const sp_cell_obs *obs, int n, sp_cell_obs *out);
+
 /**
  * @brief Node weights of one cell: w[i] = int phi_i over the elements of
  *        cell k's domain (all four nodes in its support, the solver's rule),

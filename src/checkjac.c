@@ -6,109 +6,84 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
 #include "dt_control.h"
 #include "error.h"
-#include "initial.h"
-#include "layout.h"
-#include "mesh.h"
+#include "run_setup.h"
 #include "scene.h"
 #include "softpack_solver.h"
 #include "solver_status.h"
 #include "stepper.h"
 
-/** What the command holds. */
+/** What the command holds: the scene and the run set up from it
+ *  (run_setup.h), so the Jacobians are checked on exactly the layout, node
+ *  numbering and local supports a run of the scene steps on. */
 typedef struct {
   sp_scene *scene;
-  sp_mesh *mesh;
-  sp_layout *layout;
-  sp_solver solver;
-  sp_model_params model;
-  double *state, *state_old;
-  int rank;
+  sp_run run;
+  int set_up; /* sp_run_setup was called: run to free */
 } checkjac;
 
 static void checkjac_free(checkjac *c) {
-  sp_solver_destroy(&c->solver);
-  sp_layout_destroy(&c->layout);
-  sp_mesh_destroy(&c->mesh);
+  if (c->set_up) sp_run_free(&c->run);
   sp_scene_destroy(&c->scene);
-  free(c->state);
-  free(c->state_old);
-}
-
-/** Mesh, full layout, solver and initial state, as the stepper builds them. */
-static int checkjac_setup(checkjac *c) {
-  const sp_scene *scene = c->scene;
-  MPI_Comm_rank(MPI_COMM_WORLD, &c->rank);
-  SP_CALL(sp_mesh_from_scene(scene, &c->mesh));
-  int n_cells;
-  SP_CALL(sp_initial_cell_count(scene, &n_cells));
-  SP_CALL(sp_layout_create_full(c->mesh->n_nodes, n_cells, &c->layout));
-  sp_solver_options opt;
-  sp_solver_options_from_scene(scene, &opt);
-  sp_model_from_scene(scene, &c->model);
-  const int status = sp_solver_create(MPI_COMM_WORLD, &opt, &c->solver);
-  if (status != SP_SOLVER_OK) return sp_solver_failed(c->solver, status, "solver");
-  SP_CALL(sp_solver_attach(c->solver, c->mesh, c->layout));
-  const size_t n_values = 2 * (size_t)c->layout->n_pairs;
-  SP_ALLOC(c->state, n_values);
-  SP_ALLOC(c->state_old, n_values);
-  return sp_initial_state(scene, c->mesh, c->layout, c->state);
 }
 
 static int compare(checkjac *c, const sp_step_data *data, int a, int b, double *out) {
-  const int status = sp_solver_compare_jacobians(c->solver, data, c->state, a, b, out);
-  if (status != SP_SOLVER_OK) return sp_solver_failed(c->solver, status, "comparing Jacobians");
+  const sp_run *run = &c->run;
+  const int status = sp_solver_compare_jacobians(run->solver, data, run->state, a, b, out);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "comparing Jacobians");
   return SP_OK;
 }
 
 /** The table for the current state; *worst_hand_ad gets the largest
  *  hand-vs-ad figure over its rows. */
 static int check_state(checkjac *c, const char *what, double t, double *worst_hand_ad) {
+  const sp_run *run = &c->run;
   /* At the start of a step: state_old = state, Jacobian at the state. */
-  memcpy(c->state_old, c->state, 2 * (size_t)c->layout->n_pairs * sizeof(double));
+  memcpy(run->state_old, run->state, 2 * (size_t)run->layout->n_pairs * sizeof(double));
   static const char *rows[] = {"all terms", "lambda = 0", "lambda_b = 0",
                                "lambda = lambda_b = 0"};
-  if (c->rank == 0)
+  if (run->rank == 0)
     printf("\n%s (t = %.6g):\n  %-24s %12s %12s %12s\n", what, t, "terms", "hand vs ad",
            "ad vs fd", "hand vs fd");
   for (int r = 0; r < 4; ++r) {
-    sp_step_data data = {.dt = c->scene->time.dt, .model = c->model,
-                         .state_old = c->state_old, .source = NULL, .shape = NULL};
+    sp_step_data data = {.dt = c->scene->time.dt, .model = run->model,
+                         .state_old = run->state_old, .source = NULL, .shape = NULL};
     if (r == 1 || r == 3) data.model.lambda = 0.0;
     if (r == 2 || r == 3) data.model.lambda_b = 0.0;
     double hand_ad, ad_fd, hand_fd;
     SP_CALL(compare(c, &data, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD, &hand_ad));
     SP_CALL(compare(c, &data, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD, &ad_fd));
     SP_CALL(compare(c, &data, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD, &hand_fd));
-    if (c->rank == 0)
+    if (run->rank == 0)
       printf("  %-24s %12.3e %12.3e %12.3e\n", rows[r], hand_ad, ad_fd, hand_fd);
     if (!(hand_ad <= *worst_hand_ad)) *worst_hand_ad = hand_ad; /* NaN sticks */
   }
   return SP_OK;
 }
 
-/** K backward-Euler steps under the run's time-step controller
- *  (dt_control.h: the scene's time.control; no error estimate here, so an
- *  adaptive controller holds its first dt), never accepting a failed
- *  Newton solve. */
+/** K backward-Euler steps of the run's state under the run's time-step
+ *  controller (dt_control.h: the scene's time.control; no error estimate
+ *  here, so an adaptive controller holds its first dt), never accepting a
+ *  failed Newton solve. No source, shape term, division or support change:
+ *  the layout stays the set-up's. */
 static int take_steps(checkjac *c, int steps, double *t, double *dt_last, int *retries) {
-  const size_t n_values = 2 * (size_t)c->layout->n_pairs;
+  sp_run *run = &c->run;
+  const size_t n_values = 2 * (size_t)run->layout->n_pairs;
   sp_dt_params p;
   sp_dt_params_from_scene(c->scene, &p);
   sp_dt_control dtc;
   sp_dt_init(&dtc, &p, c->scene->time.dt);
   for (int step = 0; step < steps;) {
     const double dt = sp_dt_propose(&dtc, *t, INFINITY, NULL);
-    memcpy(c->state_old, c->state, n_values * sizeof(double));
-    sp_step_data data = {.dt = dt, .model = c->model, .state_old = c->state_old,
+    memcpy(run->state_old, run->state, n_values * sizeof(double));
+    sp_step_data data = {.dt = dt, .model = run->model, .state_old = run->state_old,
                          .source = NULL, .shape = NULL};
     sp_step_report report;
-    int rc = sp_solver_step(c->solver, &data, c->state, &report);
-    if (rc > SP_SOLVER_NOT_CONVERGED) return sp_solver_failed(c->solver, rc, "step %d", step + 1);
+    int rc = sp_solver_step(run->solver, &data, run->state, &report);
+    if (rc > SP_SOLVER_NOT_CONVERGED) return sp_solver_failed(run->solver, rc, "step %d", step + 1);
     if (rc == 1) {
-      memcpy(c->state, c->state_old, n_values * sizeof(double));
+      memcpy(run->state, run->state_old, n_values * sizeof(double));
       ++*retries;
       if (sp_dt_newton_failed(&dtc, dt))
         return sp_error_set(SP_ERR_SOLVER, "Newton failed on step %d at t = %.6g: %s",
@@ -150,12 +125,15 @@ int sp_check_jacobian_command(int argc, char **argv) {
   checkjac c = {0};
   if (rc == SP_OK) rc = sp_scene_load(scene_path, n_set, sets, &c.scene);
   free(sets);
-  if (rc == SP_OK) rc = checkjac_setup(&c);
+  if (rc == SP_OK) {
+    c.set_up = 1;
+    rc = sp_run_setup(&c.run, c.scene, MPI_COMM_WORLD, NULL);
+  }
   double t = 0.0, worst = 0.0;
-  if (rc == SP_OK && c.rank == 0)
+  if (rc == SP_OK && c.run.rank == 0)
     printf("softpack check-jacobian %s: %d nodes, %d elements, %d cells; "
            "max over elements of max|J_a - J_b| / max|J_b|\n",
-           scene_path, c.mesh->n_nodes, c.mesh->n_elems, c.scene->n_cells);
+           scene_path, c.run.mesh->n_nodes, c.run.mesh->n_elems, c.run.layout->n_cells);
   if (rc == SP_OK) rc = check_state(&c, "initial state", t, &worst);
   if (rc == SP_OK && steps > 0) {
     double dt_last = 0.0;
@@ -166,7 +144,7 @@ int sp_check_jacobian_command(int argc, char **argv) {
              steps, steps == 1 ? "" : "s", dt_last, retries, retries == 1 ? "" : "s");
     if (rc == SP_OK) rc = check_state(&c, what, t, &worst);
   }
-  if (rc == SP_OK && c.rank == 0)
+  if (rc == SP_OK && c.run.rank == 0)
     printf("\nhand vs ad: largest relative difference %.3e (tolerance %.0e): %s\n", worst,
            SP_CHECKJAC_TOLERANCE, worst <= SP_CHECKJAC_TOLERANCE ? "ok" : "DIFFERENT");
   if (rc == SP_OK && !(worst <= SP_CHECKJAC_TOLERANCE))

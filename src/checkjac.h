@@ -2,7 +2,9 @@
  * @file checkjac.h
  * @brief `softpack check-jacobian SCENE.yaml [--steps K] [--set k=v]...`:
  *        the element Jacobians of the kinds ad, hand and fd compared on a
- *        scene's initial state and after K backward-Euler steps.
+ *        scene's initial state and after K backward-Euler steps, on the
+ *        run's own set-up (run_setup.h: the same layout, node numbering
+ *        and local supports as `softpack run` of the scene).
  */
 #ifndef SP_CHECKJAC_H
 #define SP_CHECKJAC_H

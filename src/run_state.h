@@ -1,9 +1,10 @@
 /**
  * @file run_state.h
  * @brief The run's state in one object: everything a step depends on, with
- *        one lifecycle (set up by the stepper, saved and restored whole by
- *        checkpoint.c). A field added here that a step reads must be added
- *        to the checkpoint too (checkpoint.c lists what it holds).
+ *        one lifecycle (set up and freed by run_setup.h, stepped by the
+ *        stepper, saved and restored whole by checkpoint.c). A field
+ *        added here that a step reads must be added to the checkpoint too
+ *        (checkpoint.c lists what it holds).
  *
  * What a step depends on:
  * - the layout and the fields on it: state (c, mu), and the history of

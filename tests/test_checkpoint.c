@@ -1,8 +1,9 @@
 /* Checkpoints alone (src/checkpoint.c), no time stepping:
- * - a round trip of the run state: a state with every member set (two
+ * - a round trip of the run state: a run set up from a scene as a run is
+ *   (scene_fixture.h), moved to random supports with every member set (two
  *   past states, a registry, the controller, the counters, the energy
- *   history) is written, read back into another run and compared member by
- *   member, bit for bit;
+ *   history), is written, and a run set up from the checkpoint as a
+ *   restart is compares equal to it member by member, bit for bit;
  * - output.checkpoint_keep keeps the newest files only, and the newest
  *   valid one is found past a damaged newer one;
  * - a truncated file, a flipped byte, an HDF5 file that is not a
@@ -17,7 +18,7 @@
 #include "check.h"
 #include "checkpoint.h"
 #include "error.h"
-#include "run_state.h"
+#include "scene_fixture.h"
 
 #define DIR "checkpoint_test"
 
@@ -35,28 +36,28 @@ static double *random_array(size_t n) {
   return a;
 }
 
-/** A run on @p mesh with three cells on random supports and every member
- *  of the state set. */
-static void fill_run(sp_run *run, const sp_scene *scene, sp_mesh *mesh, sp_run_summary *sum) {
-  memset(run, 0, sizeof *run);
-  memset(sum, 0, sizeof *sum);
-  run->scene = scene;
-  run->mesh = mesh;
-  run->sum = sum;
-  run->n_ranks = 1;
+/** A run of @p scene (three cells) as the run sets it up (scene_fixture.h),
+ *  then moved to random supports and every member of the state set to
+ *  values of its own (a set-up leaves the history, controller and counters
+ *  empty and the registry plain). */
+static scene_run *fill_run(const sp_scene *scene) {
+  scene_run *s = scene_run_setup(scene);
+  sp_run *run = &s->run;
   static const char text[] = "a scene's text";
   static const char *const set[] = {"time.t_end=1", "output.every=3"};
   run->scene_text = text;
   run->scene_len = strlen(text);
   run->n_set = 2;
   run->set = set;
-  const int nn = mesh->n_nodes, nc = 3;
+  const int nn = run->mesh->n_nodes, nc = 3;
+  CHECK(run->layout->n_cells == nc, "the scene's set-up has %d cells", run->layout->n_cells);
   unsigned char *mask = malloc((size_t)nn * nc);
   for (size_t i = 0; i < (size_t)nn * nc; ++i) mask[i] = uniform() < 0.6;
-  CHECK_OK(sp_layout_create_from_masks(nn, nc, mask, &run->layout));
+  sp_layout *layout;
+  CHECK_OK(sp_layout_create_from_masks(nn, nc, mask, &layout));
   free(mask);
-  const size_t nv = 2 * (size_t)run->layout->n_pairs;
-  run->state = random_array(nv);
+  const size_t nv = 2 * (size_t)layout->n_pairs;
+  CHECK_OK(sp_run_adopt_layout(run, layout, random_array(nv), SP_HISTORY_RESET));
   run->hist.n = 2;
   run->hist.past[0] = random_array(nv);
   run->hist.past[1] = random_array(nv);
@@ -65,11 +66,6 @@ static void fill_run(sp_run *run, const sp_scene *scene, sp_mesh *mesh, sp_run_s
   run->step = 17;
   run->t = 0.0123;
   run->n_max = 9;
-  run->obs = calloc(nc, sizeof *run->obs);
-  run->birth = calloc(nc, sizeof *run->birth);
-  run->source_on = calloc(nc, sizeof(int));
-  run->division_skipped = calloc(nc, sizeof(int));
-  run->divided_now = calloc(nc, 1);
   for (int k = 0; k < nc; ++k) {
     run->birth[k] = (sp_cell_birth){.birth_time = uniform(), .birth_mass = uniform(),
                                     .Iref = {uniform(), uniform()}, .generation = k + 1};
@@ -81,33 +77,20 @@ static void fill_run(sp_run *run, const sp_scene *scene, sp_mesh *mesh, sp_run_s
                              .ceiling = uniform(), .ceiling_steps = 4, .since_restart = 5,
                              .err_prev = uniform(), .dt_last = uniform(), .rejected_last = 1,
                              .n_accepted = 6, .n_rejected = 7, .n_newton_failed = 8};
-  *sum = (sp_run_summary){.steps = 17, .failed_attempts = 2, .newton_its = 40,
-                          .factorisations = 30, .failed_factorisations = 5, .linear_its = 9,
-                          .t_final = 0.0123, .dt_smallest = 1e-6, .wall_seconds = 3.5,
-                          .t_assembly = 1, .t_factor = 2, .t_solve = 0.5, .divisions = 2,
-                          .n_cells = 3, .layout_changes = 4, .support_mass_correction = 1e-3,
-                          .t_layout = 0.1, .support_mass_dropped = 1e-14,
-                          .support_energy_rise = 0.01, .unknowns_max = 1234,
-                          .checkpoints = 3, .t_checkpoints = 0.25};
+  s->sum = (sp_run_summary){.steps = 17, .failed_attempts = 2, .newton_its = 40,
+                            .factorisations = 30, .failed_factorisations = 5, .linear_its = 9,
+                            .t_final = 0.0123, .dt_smallest = 1e-6, .wall_seconds = 3.5,
+                            .t_assembly = 1, .t_factor = 2, .t_solve = 0.5, .divisions = 2,
+                            .n_cells = 3, .layout_changes = 4, .support_mass_correction = 1e-3,
+                            .t_layout = 0.1, .support_mass_dropped = 1e-14,
+                            .support_energy_rise = 0.01, .unknowns_max = 1234,
+                            .checkpoints = 3, .t_checkpoints = 0.25};
   run->n_energy = run->cap_energy = 5;
   run->energy_t = random_array(5);
   run->energy_total = random_array(5);
   run->n_divisions = 2;
   run->division_t = random_array(2);
-}
-
-static void free_run(sp_run *run) {
-  sp_layout_destroy(&run->layout);
-  free(run->state);
-  sp_history_free(&run->hist);
-  free(run->obs);
-  free(run->birth);
-  free(run->source_on);
-  free(run->division_skipped);
-  free(run->divided_now);
-  free(run->energy_t);
-  free(run->energy_total);
-  free(run->division_t);
+  return s;
 }
 
 /** The members in which two runs' states differ (printed if @p say). */
@@ -156,32 +139,25 @@ static int differences(const sp_run *a, const sp_run *b, int say) {
   return n;
 }
 
-/** Open and restore @p path into @p run (zeroed first) on @p mesh. */
-static int restore(const char *path, const sp_scene *scene, sp_mesh *mesh, sp_run *run,
-                   sp_run_summary *sum) {
-  memset(run, 0, sizeof *run);
-  memset(sum, 0, sizeof *sum);
-  run->scene = scene;
-  run->mesh = mesh;
-  run->sum = sum;
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &run->layout));
+/** A run of @p scene set up from the checkpoint @p path, as a run
+ *  continued from it is (sp_run_setup from a checkpoint); *out NULL if
+ *  that fails, with its code returned. */
+static int restore(const char *path, const sp_scene *scene, scene_run **out) {
+  *out = NULL;
   sp_checkpoint ck;
   int rc = sp_checkpoint_open(path, &ck);
   if (rc != SP_OK) return rc;
-  sp_output_field *fields = NULL;
-  int n_fields = 0;
-  rc = sp_checkpoint_restore(ck, run, 0, &fields, &n_fields);
-  free(fields);
+  const sp_run_start start = {.checkpoint = ck};
+  rc = scene_run_start(scene, &start, out);
   sp_checkpoint_close(&ck);
   return rc;
 }
 
-static void round_trip(const sp_scene *scene, sp_mesh *mesh) {
-  sp_run a, b;
-  sp_run_summary sa, sb;
-  fill_run(&a, scene, mesh, &sa);
+static void round_trip(const sp_scene *scene) {
+  scene_run *sa = fill_run(scene), *sb;
+  sp_run *a = &sa->run;
   char path[4096];
-  CHECK_OK(sp_checkpoint_write(&a, DIR, path, sizeof path));
+  CHECK_OK(sp_checkpoint_write(a, DIR, path, sizeof path));
   CHECK(strcmp(path, DIR "/checkpoint_000017.h5") == 0, "written to %s", path);
   sp_checkpoint ck;
   CHECK_OK(sp_checkpoint_open(path, &ck));
@@ -192,17 +168,18 @@ static void round_trip(const sp_scene *scene, sp_mesh *mesh) {
   int n_set;
   const char *const *set;
   const char *text = sp_checkpoint_scene(ck, &len, &n_set, &set);
-  CHECK(len == a.scene_len && memcmp(text, a.scene_text, len) == 0, "scene text");
-  CHECK(n_set == 2 && strcmp(set[0], a.set[0]) == 0 && strcmp(set[1], a.set[1]) == 0,
+  CHECK(len == a->scene_len && memcmp(text, a->scene_text, len) == 0, "scene text");
+  CHECK(n_set == 2 && strcmp(set[0], a->set[0]) == 0 && strcmp(set[1], a->set[1]) == 0,
         "overrides");
   sp_checkpoint_close(&ck);
-  CHECK_OK(restore(path, scene, mesh, &b, &sb));
-  CHECK(differences(&a, &b, 1) == 0, "the state differs after the round trip");
+  CHECK_OK(restore(path, scene, &sb));
+  CHECK(sb->run.restarted && differences(a, &sb->run, 1) == 0,
+        "the state differs after the round trip");
   /* keep 2: writing steps 18 and 19 leaves 18 and 19 */
-  a.step = 18;
-  CHECK_OK(sp_checkpoint_write(&a, DIR, NULL, 0));
-  a.step = 19;
-  CHECK_OK(sp_checkpoint_write(&a, DIR, NULL, 0));
+  a->step = 18;
+  CHECK_OK(sp_checkpoint_write(a, DIR, NULL, 0));
+  a->step = 19;
+  CHECK_OK(sp_checkpoint_write(a, DIR, NULL, 0));
   CHECK(access(DIR "/checkpoint_000017.h5", F_OK) != 0, "checkpoint 17 kept (keep = 2)");
   CHECK(access(DIR "/checkpoint_000018.h5", F_OK) == 0, "checkpoint 18 deleted");
   char newest[4096];
@@ -212,8 +189,8 @@ static void round_trip(const sp_scene *scene, sp_mesh *mesh) {
   CHECK_OK(sp_checkpoint_find_newest(DIR, newest, sizeof newest));
   CHECK(strcmp(newest, DIR "/checkpoint_000018.h5") == 0, "newest past a damaged one: %s",
         newest);
-  free_run(&a);
-  free_run(&b);
+  scene_run_free(&sa);
+  scene_run_free(&sb);
 }
 
 /** sp_checkpoint_open must refuse @p path as bad input with @p words in its message. */
@@ -233,7 +210,7 @@ static void copy_file(const char *from, const char *to) {
   if (out) fclose(out);
 }
 
-static void bad_files(const sp_scene *scene, sp_mesh *mesh) {
+static void bad_files(const sp_scene *scene) {
   const char *good = DIR "/checkpoint_000018.h5";
   /* truncated */
   copy_file(good, DIR "/truncated.h5");
@@ -243,9 +220,8 @@ static void bad_files(const sp_scene *scene, sp_mesh *mesh) {
   refused(DIR "/truncated.h5", "damaged");
   /* one byte flipped at 64 places: refused, or (a byte nothing reads)
    * the same state restored */
-  sp_run g, r;
-  sp_run_summary sg, sr;
-  CHECK_OK(restore(good, scene, mesh, &g, &sg));
+  scene_run *g, *r;
+  CHECK_OK(restore(good, scene, &g));
   int n_refused = 0;
   for (int where = 0; where < 64; ++where) {
     copy_file(good, DIR "/flipped.h5");
@@ -256,16 +232,17 @@ static void bad_files(const sp_scene *scene, sp_mesh *mesh) {
     fseek(f, at, SEEK_SET);
     fputc(c ^ 0x5a, f);
     fclose(f);
-    const int rc = restore(DIR "/flipped.h5", scene, mesh, &r, &sr);
+    const int rc = restore(DIR "/flipped.h5", scene, &r);
     CHECK(rc == SP_OK || rc == SP_ERR_INPUT, "byte %ld flipped: rc %d", at, rc);
     if (rc == SP_OK)
-      CHECK(differences(&g, &r, 1) == 0, "byte %ld flipped: a different state was accepted", at);
+      CHECK(differences(&g->run, &r->run, 1) == 0,
+            "byte %ld flipped: a different state was accepted", at);
     n_refused += rc != SP_OK;
-    free_run(&r);
+    scene_run_free(&r);
   }
   printf("a byte flipped at 64 places: %d refused, %d in bytes nothing reads\n", n_refused,
          64 - n_refused);
-  free_run(&g);
+  scene_run_free(&g);
   /* a byte of each array's values flipped (a bit error in the data that
    * HDF5's own structures would not notice): refused by its checksum */
   static const char *const arrays[] = {"/state", "/history/past0", "/history/past1",
@@ -284,11 +261,11 @@ static void bad_files(const sp_scene *scene, sp_mesh *mesh) {
     fseek(f, (long)offset + 3, SEEK_SET);
     fputc(c ^ 0x10, f);
     fclose(f);
-    const int rc = restore(DIR "/flipped.h5", scene, mesh, &r, &sr);
+    const int rc = restore(DIR "/flipped.h5", scene, &r);
     CHECK(rc == SP_ERR_INPUT, "a byte of %s flipped: rc %d", arrays[i], rc);
     CHECK(strstr(sp_error_message(), "checksum"), "a byte of %s flipped: '%s'", arrays[i],
           sp_error_message());
-    free_run(&r);
+    scene_run_free(&r);
   }
   /* not HDF5 */
   FILE *f = fopen(DIR "/text.h5", "w");
@@ -317,14 +294,13 @@ int main(int argc, char **argv) {
   mkdir(DIR, 0777);
   static const char text[] = "mesh: {type: rectangle, nx: 8, ny: 6}\n"
                              "output: {checkpoint_keep: 2}\n"
-                             "cells:\n  - {x: 0.5, y: 0.5, radius: 0.2}\n";
+                             "cells:\n  - {x: 0.3, y: 0.5, radius: 0.15}\n"
+                             "  - {x: 0.7, y: 0.5, radius: 0.15}\n"
+                             "  - {x: 0.5, y: 0.8, radius: 0.1}\n";
   sp_scene *scene;
   CHECK_OK(sp_scene_load_text("test", text, strlen(text), 0, NULL, &scene));
-  sp_mesh *mesh;
-  CHECK_OK(sp_mesh_from_scene(scene, &mesh));
-  round_trip(scene, mesh);
-  bad_files(scene, mesh);
-  sp_mesh_destroy(&mesh);
+  round_trip(scene);
+  bad_files(scene);
   sp_scene_destroy(&scene);
   MPI_Finalize();
   TEST_DONE();

@@ -20,6 +20,7 @@
 #include "initial.h"
 #include "output_read.h"
 #include "scene.h"
+#include "scene_fixture.h"
 #include "stepper.h"
 
 #define W 200
@@ -32,33 +33,31 @@ static const struct {
 } disks[3] = {{0.05, 0.08, 0.07, 0x00ff00}, {-0.25, 0.0, 0.08, 0xff0000},
               {0.28, -0.05, 0.09, 0x0000ff}};
 
-/** A scene's initial fields on the full layout of its mesh, and the
- *  cells' observables (threshold @p threshold): what the files say. */
+/** A scene's initial fields as a run sets them up (scene_fixture.h: the
+ *  scenes here have at most 3 cells and no division, so their layout is
+ *  the full one; the mesh is in RCB numbering, which the coordinates the
+ *  checks use do not see), and the cells' observables (threshold
+ *  @p threshold): what the files say. */
 typedef struct {
   int n;
-  sp_mesh *mesh;
-  sp_layout *layout;
-  double *state;
+  scene_run *set_up;
   sp_cell_obs *obs;
 } initial_fields;
 
 static initial_fields initial_of(const sp_scene *scene, double threshold) {
   initial_fields f;
-  CHECK_OK(sp_initial_cell_count(scene, &f.n));
-  CHECK_OK(sp_mesh_from_scene(scene, &f.mesh));
-  CHECK_OK(sp_layout_create_full(f.mesh->n_nodes, f.n, &f.layout));
-  f.state = calloc(2 * (size_t)f.layout->n_pairs, sizeof(double));
-  CHECK_OK(sp_initial_state(scene, f.mesh, f.layout, f.state));
+  f.set_up = scene_run_setup(scene);
+  const sp_run *run = &f.set_up->run;
+  f.n = run->layout->n_cells;
+  CHECK(!run->support, "a scene of %d cells on local supports", f.n);
   f.obs = calloc(f.n, sizeof *f.obs);
-  CHECK_OK(sp_cells_observe(f.mesh, f.layout, f.state, threshold, f.obs));
+  CHECK_OK(sp_cells_observe(run->mesh, run->layout, run->state, threshold, f.obs));
   return f;
 }
 
 static void initial_free(initial_fields *f) {
   free(f->obs);
-  free(f->state);
-  sp_layout_destroy(&f->layout);
-  sp_mesh_destroy(&f->mesh);
+  scene_run_free(&f->set_up);
 }
 
 static void label_image(void) {

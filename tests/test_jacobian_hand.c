@@ -9,8 +9,8 @@
  *  - Newton takes the same iterations with ad and hand on steps of a
  *    3-cell scene (test_newton.c's), to the same states (1e-10);
  *  - `softpack check-jacobian` on tests/scenes/two_overlapping.yaml and on
- *    tests/scenes/five_overlapping.yaml (5 cells on every element: DFad)
- *    exits 0, and the figures it prints, at the initial state and after a
+ *    tests/scenes/five_overlapping.yaml (5 cells on the central elements
+ *    of the run's local supports: DFad) exits 0, and the figures it prints, at the initial state and after a
  *    step, are hand = ad to 1e-12 and ad = fd to 1e-6. */
 #include <string.h>
 
@@ -189,7 +189,7 @@ int main(int argc, char **argv) {
   division_cut();
   newton_same_iterations();
   command_line("two_overlapping.yaml", "--set mesh.nx=16 --set mesh.ny=16");
-  command_line("five_overlapping.yaml", ""); /* 5 cells on every element: DFad */
+  command_line("five_overlapping.yaml", ""); /* 5 cells on central elements: DFad */
   MPI_Finalize();
   TEST_DONE();
 }

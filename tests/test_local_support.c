@@ -13,7 +13,9 @@
  *   cell's mass is kept to 1e-10 at every step, and the energy law of
  *   backward Euler holds at every step (no rise beyond round-off, except
  *   the rise a support change itself reports);
- * - after a division the children's supports cover the children. */
+ * - after a division the children's supports cover the children; the
+ *   run's first step solves on the local layout sp_run_setup builds for
+ *   the scene (scene_fixture.h). */
 #include <string.h>
 
 #include "check.h"
@@ -25,6 +27,7 @@
 #include "layout.h"
 #include "mesh.h"
 #include "output_read.h"
+#include "scene_fixture.h"
 
 /* The solutions are compared through cells.csv and energy.csv
  * (output_read.h), not the nodal fields. */
@@ -324,8 +327,14 @@ int main(int argc, char **argv) {
    * full supports (the full run of the same scene logs exactly that). */
   csv_table e;
   CHECK(csv_read("local_divide/energy.csv", &e) == 0 && e.n_rows > 2, "local_divide/energy.csv");
-  sp_mesh *mesh;
-  CHECK_OK(sp_mesh_from_scene(scene, &mesh));
+  /* the scene set up as the run set it up (scene_fixture.h): the first
+   * step solved on its initial local supports */
+  scene_run *set_up = scene_run_setup(scene);
+  const sp_mesh *mesh = set_up->run.mesh;
+  CHECK(set_up->run.support && (long)at(&e, 1, "unknowns") == 2L * set_up->run.layout->n_pairs,
+        "the first step solved %ld unknowns, the set-up has %d pairs on %s supports",
+        (long)at(&e, 1, "unknowns"), set_up->run.layout->n_pairs,
+        set_up->run.support ? "local" : "full");
   long u_max = 0;
   int u_changes = 0, bad_changes = 0;
   for (int i = 1; i < e.n_rows; ++i) {
@@ -345,7 +354,7 @@ int main(int argc, char **argv) {
   CHECK(u_max < 2L * 4 * mesh->n_nodes / 2, "local supports: %ld unknowns of %d", u_max,
         2 * 4 * mesh->n_nodes);
   free(e.v);
-  sp_mesh_destroy(&mesh);
+  scene_run_free(&set_up);
   sp_scene_destroy(&scene);
   MPI_Finalize();
   TEST_DONE();
