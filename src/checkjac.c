@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "agree.h"
 #include "dt_control.h"
 #include "error.h"
 #include "run_setup.h"
@@ -125,24 +126,35 @@ int sp_check_jacobian_command(int argc, char **argv) {
   checkjac c = {0};
   if (rc == SP_OK) rc = sp_scene_load(scene_path, n_set, sets, &c.scene);
   free(sets);
+  /* Every phase below is collective: the ranks agree on their errors
+   * before each (agree.h), so a failure on one rank ends every rank with
+   * its message, never a hang or an MPI_Abort. */
+  MPI_Comm agree = MPI_COMM_NULL;
+  const int rc_comm = sp_agree_comm_create(MPI_COMM_WORLD, &agree);
+  if (rc_comm != SP_OK) {
+    checkjac_free(&c);
+    return rc_comm;
+  }
+  rc = sp_agree(agree, rc);
   if (rc == SP_OK) {
     c.set_up = 1;
     rc = sp_run_setup(&c.run, c.scene, MPI_COMM_WORLD, NULL);
   }
+  rc = sp_agree(agree, rc);
   double t = 0.0, worst = 0.0;
   if (rc == SP_OK && c.run.rank == 0)
     printf("softpack check-jacobian %s: %d nodes, %d elements, %d cells; "
            "max over elements of max|J_a - J_b| / max|J_b|\n",
            scene_path, c.run.mesh->n_nodes, c.run.mesh->n_elems, c.run.layout->n_cells);
-  if (rc == SP_OK) rc = check_state(&c, "initial state", t, &worst);
+  if (rc == SP_OK) rc = sp_agree(agree, check_state(&c, "initial state", t, &worst));
   if (rc == SP_OK && steps > 0) {
     double dt_last = 0.0;
     int retries = 0;
-    rc = take_steps(&c, steps, &t, &dt_last, &retries);
+    rc = sp_agree(agree, take_steps(&c, steps, &t, &dt_last, &retries));
     char what[160];
     snprintf(what, sizeof what, "after %d step%s (last dt %.3g, %d failed attempt%s retried)",
              steps, steps == 1 ? "" : "s", dt_last, retries, retries == 1 ? "" : "s");
-    if (rc == SP_OK) rc = check_state(&c, what, t, &worst);
+    if (rc == SP_OK) rc = sp_agree(agree, check_state(&c, what, t, &worst));
   }
   if (rc == SP_OK && c.run.rank == 0)
     printf("\nhand vs ad: largest relative difference %.3e (tolerance %.0e): %s\n", worst,
@@ -150,6 +162,8 @@ int sp_check_jacobian_command(int argc, char **argv) {
   if (rc == SP_OK && !(worst <= SP_CHECKJAC_TOLERANCE))
     rc = sp_error_set(SP_ERR_SOLVER, "the hand and ad Jacobians differ by %.3e relative "
                       "(> %.0e)", worst, SP_CHECKJAC_TOLERANCE);
+  rc = sp_agree(agree, rc);
+  sp_agree_comm_free(&agree);
   checkjac_free(&c);
   return rc;
 }

@@ -29,7 +29,7 @@
  *   mpi_compare faults         (run without mpirun)
  *     The real program under `mpirun -np 2` with a fault on rank 1 at
  *     set-up, in the solver's creation, in a step, at output and in the
- *     glue's residual fill: every run
+ *     glue's residual fill, and check-jacobian with that last one: every run
  *     ends within seconds (timeout -s KILL 60 makes a hang fail), exit
  *     status 1, the message on stderr; and rank 1 killed by SIGKILL in a
  *     step ends the run (mpirun tears the job down), not a hang.
@@ -459,6 +459,22 @@ static int cmd_faults(void) {
     const char *const names[] = {faults[i][1], faults[i][2], faults[i][3], NULL};
     expect_failure(what, args, 1, names);
   }
+  /* check-jacobian agrees its errors too: a fault in rank 1's residual
+   * fill (its steps) ends both ranks with exit 1, not by MPI_Abort */
+  char checkjac[4096];
+  snprintf(checkjac, sizeof checkjac, "check-jacobian %s/tests/scenes/divide_1_2_4.yaml "
+           "--steps 1 --set layout.support=local", SP_SOURCE_DIR);
+  setenv("SOFTPACK_FAULT", "assembly:1", 1);
+  {
+    static const char *const names[] = {"(memory)", "rank 1", "assembly", NULL};
+    expect_failure("check-jacobian, SOFTPACK_FAULT=assembly:1, np 2", checkjac, 1, names);
+  }
+  char abort_out[16384];
+  double abort_seconds = 0;
+  run_mpi(2, checkjac, abort_out, sizeof abort_out, &abort_seconds);
+  unsetenv("SOFTPACK_FAULT");
+  CHECK(strstr(abort_out, "MPI_ABORT") == NULL && strstr(abort_out, "MPI_Abort") == NULL,
+        "check-jacobian with a fault on rank 1 ended by MPI_Abort:\n%s", abort_out);
   /* a rank killed: mpirun ends the job (its status is the signal's) */
   setenv("SOFTPACK_FAULT", "step:1:kill", 1);
   char out[16384];
