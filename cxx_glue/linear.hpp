@@ -10,6 +10,8 @@
 #include <memory>
 #include <string>
 
+class Epetra_CrsMatrix;
+
 namespace sp {
 
 // This rank's rows of a square n_global x n_global matrix distributed by
@@ -31,6 +33,11 @@ struct CsrRows {
   const int *row_ptr = nullptr;  // n_rows + 1 offsets into col/val
   const int *col = nullptr;      // global column indices
   double *val = nullptr;         // overwritten by some backends' factor()
+  // The same rows as an Epetra matrix when the caller has one that is
+  // exactly them (the Jacobian on one process), else null: a backend
+  // that factors an Epetra matrix (Amesos) factors it instead of a copy.
+  // It stays alive and keeps its pattern while the layout does.
+  Epetra_CrsMatrix *matrix = nullptr;
 };
 
 // Every call is collective over the solver's communicator.
@@ -64,6 +71,9 @@ class DirectSolver {
   // call, and the caller may hand it storage it keeps using: Solver gives
   // the Jacobian's own arrays on one process).
   virtual bool overwrites_values() const { return false; }
+  // The caller's matrix (CsrRows.matrix) is about to go: let go of
+  // everything that refers to it (the next factor() starts anew).
+  virtual void forget_matrix() {}
 };
 
 // Serial SuperLU (dgstrf/dgstrs on the transposed CSC view of the CSR); one

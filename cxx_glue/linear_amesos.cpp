@@ -1,12 +1,16 @@
-// Amesos (v1) direct solvers (MUMPS, KLU) on an Epetra copy of the CSR rows
-// (epetra_rows.hpp), built once per pattern with SymbolicFactorization()
-// once; each factor() overwrites the values in place and calls
+// Amesos (v1) direct solvers (MUMPS, KLU) on the caller's Epetra matrix
+// when it has one that is the rows (the Jacobian on one process), else on
+// an Epetra copy of the CSR rows (epetra_rows.hpp), built once per pattern
+// with SymbolicFactorization() once; each factor() overwrites the copy's
+// values in place (the caller's matrix has them already) and calls
 // NumericFactorization() (the stock NOX Amesos class redoes the symbolic
 // step every time).
 #include <Amesos.h>
 #include <Amesos_BaseSolver.h>
 #include <Amesos_Mumps.h>
+#include <Epetra_CrsMatrix.h>
 #include <Epetra_LinearProblem.h>
+#include <Epetra_Vector.h>
 #include <Teuchos_ParameterList.hpp>
 
 #include <algorithm>
@@ -31,10 +35,10 @@ class AmesosSolver final : public DirectSolver {
   ~AmesosSolver() override { release(); }
 
   bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
-    if (!same_pattern || !solver_ || !rows_->same_pattern(A)) {
-      if (!build(A, why)) return false;
-    }
-    rows_->set_values(A);
+    const bool rebuild = !same_pattern || !solver_ || A.matrix != matrix_ ||
+                         (!A.matrix && !rows_->same_pattern(A));
+    if (rebuild && !build(A, why)) return false;
+    if (!matrix_) rows_->set_values(A);  // (the caller's matrix holds them)
     const int err = solver_->NumericFactorization();
     if (err != 0) {
       why = which_ + ": numeric factorisation failed (error " + std::to_string(err) +
@@ -51,32 +55,53 @@ class AmesosSolver final : public DirectSolver {
       why = which_ + ": solve without a factorisation";
       return false;
     }
-    const int n = rows_->n_local();
-    std::copy(b, b + n, rows_->rhs().Values());
+    const int n = rhs_->MyLength();
+    std::copy(b, b + n, rhs_->Values());
     const int err = solver_->Solve();
     if (err != 0) {
       why = which_ + ": solve failed (error " + std::to_string(err) + ")";
       return false;
     }
-    std::copy(rows_->lhs().Values(), rows_->lhs().Values() + n, x);
+    std::copy(lhs_->Values(), lhs_->Values() + n, x);
     return true;
   }
 
   int symbolic_count() const override { return symbolic_; }
+  void forget_matrix() override {
+    if (matrix_) release();  // Amesos' solver refers to it, its destructor too
+  }
 
  private:
   void release() {
     solver_.reset();
     problem_.reset();
     rows_.reset();
+    own_lhs_.reset();
+    own_rhs_.reset();
+    matrix_ = nullptr;
+    lhs_ = rhs_ = nullptr;
     factored_ = false;
   }
 
+  // The problem on the caller's matrix (A.matrix) or on an Epetra copy of
+  // the rows (EpetraRows), and the symbolic factorisation.
   bool build(const CsrRows &A, std::string &why) {
     release();
-    rows_ = std::make_unique<EpetraRows>(comm_, A);
-    problem_ =
-        std::make_unique<Epetra_LinearProblem>(&rows_->matrix(), &rows_->lhs(), &rows_->rhs());
+    Epetra_RowMatrix *M;
+    if (A.matrix) {
+      matrix_ = A.matrix;
+      own_lhs_ = std::make_unique<Epetra_Vector>(matrix_->RowMap());
+      own_rhs_ = std::make_unique<Epetra_Vector>(matrix_->RowMap());
+      M = matrix_;
+      lhs_ = own_lhs_.get();
+      rhs_ = own_rhs_.get();
+    } else {
+      rows_ = std::make_unique<EpetraRows>(comm_, A);
+      M = &rows_->matrix();
+      lhs_ = &rows_->lhs();
+      rhs_ = &rows_->rhs();
+    }
+    problem_ = std::make_unique<Epetra_LinearProblem>(M, lhs_, rhs_);
     Amesos factory;
     solver_.reset(factory.Create(which_, *problem_));
     if (!solver_) throw std::runtime_error("Amesos: could not create " + which_);
@@ -107,7 +132,10 @@ class AmesosSolver final : public DirectSolver {
 
   Epetra_MpiComm comm_;
   std::string which_;
-  std::unique_ptr<EpetraRows> rows_;
+  std::unique_ptr<EpetraRows> rows_;   // the copy, when the caller has no matrix
+  Epetra_CrsMatrix *matrix_ = nullptr;  // else the caller's (CsrRows.matrix)
+  std::unique_ptr<Epetra_Vector> own_lhs_, own_rhs_;
+  Epetra_Vector *lhs_ = nullptr, *rhs_ = nullptr;
   std::unique_ptr<Epetra_LinearProblem> problem_;
   std::unique_ptr<Amesos_BaseSolver> solver_;
   bool factored_ = false;

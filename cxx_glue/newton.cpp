@@ -260,6 +260,7 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
 
 void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout) {
   if (assembly_ && assembly_->same_layout(layout)) return;
+  linear_->forget_matrix();  // (a backend may hold the old Jacobian)
   assembly_.reset(new Assembly(comm_, mesh, layout));
   jacobian_matrix = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
   // The CSR rows handed to the direct solver: this rank's rows, global
@@ -413,6 +414,7 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
       A.row_ptr = offsets;
       A.col = cols;
       A.val = vals;
+      A.matrix = jacobian_matrix.get();
     } else {
       for (int i = 0; i < n; ++i) {
         int len;
