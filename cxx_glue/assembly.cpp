@@ -46,88 +46,97 @@ struct Assembly::Gathered {
 Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
                    const sp_layout_view &layout)
     : comm_(comm), n_nodes_(layout.n_nodes), n_pairs_(layout.n_pairs),
-      n_cells_(layout.n_cells),
-      node_start_(layout.node_start, layout.node_start + layout.n_nodes + 1),
-      pair_cell_(layout.pair_cell, layout.pair_cell + layout.n_pairs) {
-  if (mesh.n_nodes != layout.n_nodes)
-    throw std::runtime_error("layout and mesh disagree on the node count");
-  // Node partition: contiguous node ranges in rank order, so each rank's
-  // DOFs are a contiguous range too (what SuperLU_DIST needs). The C core
-  // balances the ranges by unknowns along an RCB node order (partition.h);
-  // without them, equal node counts.
+      n_cells_(layout.n_cells) {
+  // Each rank's own work before a collective is agreed first (agree_local):
+  // a failure on one rank (an allocation) ends every rank here, none is
+  // left in the node map's or the graph's collective.
   const int P = comm.NumProc(), r = comm.MyPID();
   long first_node = (long)n_nodes_ * r / P, end_node = (long)n_nodes_ * (r + 1) / P;
-  if (layout.rank_first_node) {
-    if (layout.n_ranks != P)
-      throw std::runtime_error("the node partition is for " + std::to_string(layout.n_ranks) +
-                               " ranks, the communicator has " + std::to_string(P));
-    first_node = layout.rank_first_node[r];
-    end_node = layout.rank_first_node[r + 1];
-    if (first_node < 0 || end_node < first_node || end_node > n_nodes_ ||
-        layout.rank_first_node[0] != 0 || layout.rank_first_node[P] != n_nodes_)
-      throw std::runtime_error("the node partition's ranges are not increasing from 0 to the "
-                               "node count");
-  }
   std::vector<int> my_dofs;
-  for (long i = first_node; i < end_node; ++i)
-    for (int p = node_start_[i]; p < node_start_[i + 1]; ++p) {
-      my_dofs.push_back(2 * p);
-      my_dofs.push_back(2 * p + 1);
+  agree_local(comm_, [&] {
+    if (sp_fault_due(SP_FAULT_ATTACH, r))
+      throw memory_error("out of memory at attach on rank " + std::to_string(r) +
+                         " (fault injected by SOFTPACK_FAULT=attach:" + std::to_string(r) + ")");
+    node_start_.assign(layout.node_start, layout.node_start + layout.n_nodes + 1);
+    pair_cell_.assign(layout.pair_cell, layout.pair_cell + layout.n_pairs);
+    if (mesh.n_nodes != layout.n_nodes)
+      throw std::runtime_error("layout and mesh disagree on the node count");
+    // Node partition: contiguous node ranges in rank order, so each rank's
+    // DOFs are a contiguous range too (what SuperLU_DIST needs). The C core
+    // balances the ranges by unknowns along an RCB node order (partition.h);
+    // without them, equal node counts.
+    if (layout.rank_first_node) {
+      if (layout.n_ranks != P)
+        throw std::runtime_error("the node partition is for " + std::to_string(layout.n_ranks) +
+                                 " ranks, the communicator has " + std::to_string(P));
+      first_node = layout.rank_first_node[r];
+      end_node = layout.rank_first_node[r + 1];
+      if (first_node < 0 || end_node < first_node || end_node > n_nodes_ ||
+          layout.rank_first_node[0] != 0 || layout.rank_first_node[P] != n_nodes_)
+        throw std::runtime_error("the node partition's ranges are not increasing from 0 to the "
+                                 "node count");
     }
+    for (long i = first_node; i < end_node; ++i)
+      for (int p = node_start_[i]; p < node_start_[i + 1]; ++p) {
+        my_dofs.push_back(2 * p);
+        my_dofs.push_back(2 * p + 1);
+      }
+  });
   map_.reset(new Epetra_Map(-1, (int)my_dofs.size(), my_dofs.data(), 0, comm));
 
-  // Elements: geometry, and the cells living on each with their pairs: the
-  // C core's element-slot table (sp_layout_slots, the one place the
-  // whole-element rule is applied), copied since the view is borrowed.
-  if (!layout.elem_start || !layout.slot_cell || !layout.slot_pair ||
-      layout.elem_start[0] != 0 || layout.elem_start[mesh.n_elems] != layout.n_slots)
-    throw std::runtime_error("the layout view has no element-slot table for the mesh's " +
-                             std::to_string(mesh.n_elems) + " elements");
-  elem_start_.assign(layout.elem_start, layout.elem_start + mesh.n_elems + 1);
-  slot_cell_.assign(layout.slot_cell, layout.slot_cell + layout.n_slots);
-  slot_pair_.assign(layout.slot_pair, layout.slot_pair + 4 * layout.n_slots);
-  geometry_.resize(mesh.n_elems);
-  for (int e = 0; e < mesh.n_elems; ++e) {
-    const int *nodes = mesh.elem + 4 * e;
-    ElementGeometry &g = geometry_[e];
-    double xy[4][2];
-    for (int a = 0; a < 4; ++a) {
-      xy[a][0] = mesh.xy[2 * nodes[a]];
-      xy[a][1] = mesh.xy[2 * nodes[a] + 1];
-    }
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q)
-      if (sp_q1_point(xy, q, g.N[q], g.dNdx[q], g.x[q], &g.w[q]) <= 0)
-        throw std::runtime_error("mesh element " + std::to_string(e) +
-                                 " is inverted or degenerate");
-    g.buffer = mesh.region && mesh.region[e] == 1;
-    if (nodes[0] >= first_node && nodes[0] < end_node) my_elems_.push_back(e);
-  }
-
-  // Graph: within an element, coupled() entries between present unknowns.
   Epetra_FECrsGraph graph(Copy, *map_, 0);
-  Gathered scratch;
-  for (int e : my_elems_) {
-    const int nc = n_cells_on(e);
-    const int64_t s0 = elem_start_[e];
-    for (int j = 0; j < nc; ++j)
+  agree_local(comm_, [&] {
+    // Elements: geometry, and the cells living on each with their pairs: the
+    // C core's element-slot table (sp_layout_slots, the one place the
+    // whole-element rule is applied), copied since the view is borrowed.
+    if (!layout.elem_start || !layout.slot_cell || !layout.slot_pair ||
+        layout.elem_start[0] != 0 || layout.elem_start[mesh.n_elems] != layout.n_slots)
+      throw std::runtime_error("the layout view has no element-slot table for the mesh's " +
+                               std::to_string(mesh.n_elems) + " elements");
+    elem_start_.assign(layout.elem_start, layout.elem_start + mesh.n_elems + 1);
+    slot_cell_.assign(layout.slot_cell, layout.slot_cell + layout.n_slots);
+    slot_pair_.assign(layout.slot_pair, layout.slot_pair + 4 * layout.n_slots);
+    geometry_.resize(mesh.n_elems);
+    for (int e = 0; e < mesh.n_elems; ++e) {
+      const int *nodes = mesh.elem + 4 * e;
+      ElementGeometry &g = geometry_[e];
+      double xy[4][2];
       for (int a = 0; a < 4; ++a) {
-        int p = slot_pair_[4 * (s0 + j) + a];
-        if (p < 0) continue;
-        for (int f = 0; f < 2; ++f) {
-          std::vector<int> cols;
-          for (int j2 = 0; j2 < nc; ++j2)
-            for (int b = 0; b < 4; ++b) {
-              int p2 = slot_pair_[4 * (s0 + j2) + b];
-              if (p2 < 0) continue;
-              for (int f2 = 0; f2 < 2; ++f2)
-                if (coupled(j, f, j2, f2)) cols.push_back(2 * p2 + f2);
-            }
-          int row = 2 * p + f;
-          if (graph.InsertGlobalIndices(1, &row, (int)cols.size(), cols.data()) < 0)
-            throw std::runtime_error("graph insertion failed");
-        }
+        xy[a][0] = mesh.xy[2 * nodes[a]];
+        xy[a][1] = mesh.xy[2 * nodes[a] + 1];
       }
-  }
+      for (int q = 0; q < SP_Q1_QPOINTS; ++q)
+        if (sp_q1_point(xy, q, g.N[q], g.dNdx[q], g.x[q], &g.w[q]) <= 0)
+          throw std::runtime_error("mesh element " + std::to_string(e) +
+                                   " is inverted or degenerate");
+      g.buffer = mesh.region && mesh.region[e] == 1;
+      if (nodes[0] >= first_node && nodes[0] < end_node) my_elems_.push_back(e);
+    }
+
+    // Graph: within an element, coupled() entries between present unknowns.
+    for (int e : my_elems_) {
+      const int nc = n_cells_on(e);
+      const int64_t s0 = elem_start_[e];
+      for (int j = 0; j < nc; ++j)
+        for (int a = 0; a < 4; ++a) {
+          int p = slot_pair_[4 * (s0 + j) + a];
+          if (p < 0) continue;
+          for (int f = 0; f < 2; ++f) {
+            std::vector<int> cols;
+            for (int j2 = 0; j2 < nc; ++j2)
+              for (int b = 0; b < 4; ++b) {
+                int p2 = slot_pair_[4 * (s0 + j2) + b];
+                if (p2 < 0) continue;
+                for (int f2 = 0; f2 < 2; ++f2)
+                  if (coupled(j, f, j2, f2)) cols.push_back(2 * p2 + f2);
+              }
+            int row = 2 * p + f;
+            if (graph.InsertGlobalIndices(1, &row, (int)cols.size(), cols.data()) < 0)
+              throw std::runtime_error("graph insertion failed");
+          }
+        }
+    }
+  });
   if (graph.GlobalAssemble() != 0) throw std::runtime_error("graph assembly failed");
   graph_.reset(new Epetra_CrsGraph(graph));
   // Contiguous storage (one array of column indices, one offset array): a

@@ -262,16 +262,18 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   if (assembly_ && assembly_->same_layout(layout)) return;
   linear_->forget_matrix();  // (a backend may hold the old Jacobian)
   assembly_.reset(new Assembly(comm_, mesh, layout));
-  jacobian_matrix = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
   // The CSR rows handed to the direct solver: this rank's rows, global
   // column indices. The backends need each rank's rows contiguous and the
   // blocks in rank order (the node partition of Assembly gives that).
   const Epetra_CrsGraph &g = assembly_->graph();
   const int n = g.NumMyRows();
-  first_row_ = n > 0 ? g.RowMap().GID(0) : 0;
-  for (int i = 0; i < n; ++i)
-    if (g.RowMap().GID(i) != first_row_ + i)
-      throw std::logic_error("the rows of a rank are not contiguous");
+  agree_local(comm_, [&] {  // (the gathers below are collective)
+    jacobian_matrix = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
+    first_row_ = n > 0 ? g.RowMap().GID(0) : 0;
+    for (int i = 0; i < n; ++i)
+      if (g.RowMap().GID(i) != first_row_ + i)
+        throw std::logic_error("the rows of a rank are not contiguous");
+  });
   const int P = comm_.NumProc();
   std::vector<int> firsts(P), counts(P);
   MPI_Allgather(&first_row_, 1, MPI_INT, firsts.data(), 1, MPI_INT, comm_.Comm());

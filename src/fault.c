@@ -7,7 +7,7 @@
 
 #include "error.h"
 
-static const char *const phase_names[] = {"setup", "solver", "step", "output", "assembly"};
+static const char *const phase_names[] = {"setup", "solver", "step", "output", "assembly", "attach"};
 #define N_PHASES (int)(sizeof phase_names / sizeof phase_names[0])
 
 /** What SOFTPACK_FAULT asks for: 0 and *phase, *rank, *kill set; -1 if it
@@ -43,7 +43,7 @@ int sp_fault_check(sp_fault_phase phase, int rank) {
   int p, r, kill;
   if (phase == SP_FAULT_SETUP && fault_wanted(&p, &r, &kill) < 0)
     return sp_error_set(SP_ERR_INPUT, "SOFTPACK_FAULT: expected PHASE:RANK or PHASE:RANK:kill "
-                        "with PHASE setup, solver, step, output or assembly, got '%s'",
+                        "with PHASE setup, solver, step, output, assembly or attach, got '%s'",
                         getenv("SOFTPACK_FAULT"));
   if (!sp_fault_due(phase, rank)) return SP_OK;
   const char *name = phase_names[phase];

@@ -17,7 +17,9 @@
  *  - output: at every field snapshot, step 0's included (SP_ERR_IO);
  *  - assembly: in the glue's residual fill (its element loop, before the
  *            fill's collective: a memory error on that rank, the other
- *            ranks told before the collective, cxx_glue/errors.hpp).
+ *            ranks told before the collective, cxx_glue/errors.hpp);
+ *  - attach: where the glue takes a new layout (sp_solver_set_problem,
+ *            before its node map's collective: a memory error, likewise).
  * With ":kill" the rank sends itself SIGKILL there instead (not for
  * solver). Anything else in SOFTPACK_FAULT is bad input at set-up.
  * docs/robustness.md, "MPI failures".
@@ -34,7 +36,8 @@ typedef enum {
   SP_FAULT_SOLVER = 1,
   SP_FAULT_STEP = 2,
   SP_FAULT_OUTPUT = 3,
-  SP_FAULT_ASSEMBLY = 4
+  SP_FAULT_ASSEMBLY = 4,
+  SP_FAULT_ATTACH = 5
 } sp_fault_phase;
 
 /** @brief 1 if SOFTPACK_FAULT asks @p rank to fail at @p phase (a ":kill"

@@ -20,7 +20,8 @@
  *     The library under faults (src/fault.h): with SOFTPACK_FAULT set on
  *     every rank to a fault on one rank (at set-up, in the solver's
  *     creation, in a step, at output, inside the glue's residual fill
- *     before its collective; rank 1, and rank 0 for some),
+ *     and where it takes a layout, each before its collective; rank 1,
+ *     and rank 0 for some),
  *     sp_run_file returns on every rank with the fault's class
  *     (memory, solver, output) and a message naming it; then a run without
  *     a fault succeeds on every rank (the library is usable after them),
@@ -28,8 +29,9 @@
  *
  *   mpi_compare faults         (run without mpirun)
  *     The real program under `mpirun -np 2` with a fault on rank 1 at
- *     set-up, in the solver's creation, in a step, at output and in the
- *     glue's residual fill, and check-jacobian with that last one: every run
+ *     set-up, in the solver's creation, in a step, at output, in the
+ *     glue's residual fill and layout hand-over, and check-jacobian with
+ *     the residual fill's: every run
  *     ends within seconds (timeout -s KILL 60 makes a hang fail), exit
  *     status 1, the message on stderr; and rank 1 killed by SIGKILL in a
  *     step ends the run (mpirun tears the job down), not a hang.
@@ -345,7 +347,8 @@ static int cmd_library(int argc, char **argv, int rank) {
   } cases[] = {{"setup:1", SP_ERR_MEMORY}, {"solver:1", SP_ERR_SOLVER},
                {"step:1", SP_ERR_MEMORY},  {"output:1", SP_ERR_IO},
                {"step:0", SP_ERR_MEMORY},  {"output:0", SP_ERR_IO},
-               {"assembly:1", SP_ERR_MEMORY}, {"assembly:0", SP_ERR_MEMORY}};
+               {"assembly:1", SP_ERR_MEMORY}, {"assembly:0", SP_ERR_MEMORY},
+               {"attach:1", SP_ERR_MEMORY}, {"attach:0", SP_ERR_MEMORY}};
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
     setenv("SOFTPACK_FAULT", cases[i].fault, 1);
     const double t0 = MPI_Wtime();
@@ -451,7 +454,8 @@ static int cmd_faults(void) {
       {"solver:1", "(solver)", "rank 1", "solver"},
       {"step:1", "(memory)", "rank 1 of 2", "step"},
       {"output:1", "(output)", "rank 1 of 2", "fields"},
-      {"assembly:1", "(memory)", "rank 1", "assembly"}};
+      {"assembly:1", "(memory)", "rank 1", "assembly"},
+      {"attach:1", "(memory)", "rank 1", "attach"}};
   for (size_t i = 0; i < sizeof faults / sizeof faults[0]; ++i) {
     char what[64];
     snprintf(what, sizeof what, "SOFTPACK_FAULT=%s, np 2", faults[i][0]);
