@@ -20,37 +20,18 @@ struct sp_solver_s {
 
 namespace {
 
-// Each exception as its class (errors.hpp); the message stays in the handle.
+// Each exception as its class (sp::error_status); the message stays in the
+// handle.
 template <class F> int guarded(sp_solver s, F &&body) {
-  auto keep = [s](const std::string &what) {
-    if (s) s->error = what;
-  };
   try {
     body();
     return SP_SOLVER_OK;
-  } catch (const sp::input_error &e) {
-    keep(e.what());
-    return SP_SOLVER_ERR_INPUT;
-  } catch (const std::bad_alloc &e) {
-    keep(std::string("out of memory in the Trilinos glue (") + e.what() + ")");
-    return SP_SOLVER_ERR_MEMORY;
-  } catch (const sp::memory_error &e) {
-    keep(e.what());
-    return SP_SOLVER_ERR_MEMORY;
-  } catch (const sp::mpi_error &e) {
-    keep(e.what());
-    return SP_SOLVER_ERR_MPI;
-  } catch (const std::logic_error &e) {
-    keep(e.what());
-    return SP_SOLVER_ERR_INTERNAL;
-  } catch (const std::exception &e) {
-    keep(e.what());
-  } catch (const char *e) {
-    keep(std::string("NOX: ") + e);
   } catch (...) {
-    keep("unknown exception in the Trilinos glue");
+    std::string what;
+    const int status = sp::error_status(std::current_exception(), what);
+    if (s) s->error = what;
+    return status;
   }
-  return SP_SOLVER_ERR_SOLVER;
 }
 
 void need(bool ok, const char *what) {

@@ -1,52 +1,68 @@
 #include "errors.hpp"
 
 #include <Epetra_Comm.h>
+#include <Epetra_MpiComm.h>
 
 #include <exception>
 #include <new>
-#include <vector>
+
+#include "softpack_solver.h"
 
 namespace sp {
 
-namespace {
-
-// The classes of c_api.cpp's guarded(), in its order of catching.
-enum ErrorClass { OK = 0, INPUT, MEMORY, MPI, INTERNAL, SOLVER };
-
-ErrorClass classify(std::exception_ptr e, std::string &what) {
+int error_status(std::exception_ptr e, std::string &what) {
   try {
     std::rethrow_exception(e);
   } catch (const input_error &x) {
     what = x.what();
-    return INPUT;
+    return SP_SOLVER_ERR_INPUT;
   } catch (const memory_error &x) {
     what = x.what();
-    return MEMORY;
+    return SP_SOLVER_ERR_MEMORY;
   } catch (const std::bad_alloc &x) {
     what = std::string("out of memory in the Trilinos glue (") + x.what() + ")";
-    return MEMORY;
+    return SP_SOLVER_ERR_MEMORY;
   } catch (const mpi_error &x) {
     what = x.what();
-    return MPI;
+    return SP_SOLVER_ERR_MPI;
   } catch (const std::logic_error &x) {
     what = x.what();
-    return INTERNAL;
+    return SP_SOLVER_ERR_INTERNAL;
   } catch (const std::exception &x) {
     what = x.what();
-  } catch (const char *x) {
+  } catch (const char *x) {  // NOX throws these too
     what = std::string("NOX: ") + x;
   } catch (...) {
     what = "unknown exception in the Trilinos glue";
   }
-  return SOLVER;
+  return SP_SOLVER_ERR_SOLVER;
 }
 
-[[noreturn]] void throw_as(ErrorClass c, const std::string &what) {
-  switch (c) {
-    case INPUT: throw input_error(what);
-    case MEMORY: throw memory_error(what);
-    case MPI: throw mpi_error(what);
-    case INTERNAL: throw std::logic_error(what);
+int lowest_failure(MPI_Comm comm, bool failed, int &status, std::string &why) {
+  int rank, size;
+  check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
+  check_mpi(MPI_Comm_size(comm, &size), "MPI_Comm_size");
+  int mine = failed ? rank : size, first = size;
+  check_mpi(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm), "MPI_Allreduce");
+  if (first == size) return -1;
+  int head[2] = {status, (int)why.size()};  // the failing rank's
+  check_mpi(MPI_Bcast(head, 2, MPI_INT, first, comm), "MPI_Bcast");
+  std::string text(head[1], ' ');
+  if (rank == first) text = why;
+  if (head[1] > 0) check_mpi(MPI_Bcast(&text[0], head[1], MPI_CHAR, first, comm), "MPI_Bcast");
+  status = head[0];
+  why = text;
+  return first;
+}
+
+namespace {
+
+[[noreturn]] void throw_as(int status, const std::string &what) {
+  switch (status) {
+    case SP_SOLVER_ERR_INPUT: throw input_error(what);
+    case SP_SOLVER_ERR_MEMORY: throw memory_error(what);
+    case SP_SOLVER_ERR_MPI: throw mpi_error(what);
+    case SP_SOLVER_ERR_INTERNAL: throw std::logic_error(what);
     default: throw std::runtime_error(what);
   }
 }
@@ -60,30 +76,19 @@ void agree_local(const Epetra_Comm &comm, const std::function<void()> &local) {
   } catch (...) {
     failed = std::current_exception();
   }
-  const int size = comm.NumProc(), rank = comm.MyPID();
-  if (size == 1) {
+  const auto *mpi = dynamic_cast<const Epetra_MpiComm *>(&comm);
+  if (!mpi || comm.NumProc() == 1) {
     if (failed) std::rethrow_exception(failed);
     return;
   }
-  int mine = failed ? rank : size, first = size;
-  if (comm.MinAll(&mine, &first, 1) != 0) throw mpi_error("MPI: agreeing on a local failure");
-  if (first == size) return;
   // The failing rank tells the others its class and message, then rethrows.
   std::string what;
-  int head[2] = {0, 0};  // class, message length
-  if (rank == first) {
-    head[0] = classify(failed, what);
-    head[1] = (int)what.size();
-  }
-  if (comm.Broadcast(head, 2, first) != 0) throw mpi_error("MPI: broadcasting a local failure");
-  std::vector<char> text(head[1] + 1, '\0');
-  if (rank == first) what.copy(text.data(), what.size());
-  if (head[1] > 0 && comm.Broadcast(text.data(), head[1], first) != 0)
-    throw mpi_error("MPI: broadcasting a local failure");
-  if (rank == first) std::rethrow_exception(failed);
-  throw_as(static_cast<ErrorClass>(head[0]),
-           "on rank " + std::to_string(first) + " of " + std::to_string(size) + ": " +
-               std::string(text.data(), head[1]));
+  int status = failed ? error_status(failed, what) : SP_SOLVER_OK;
+  const int first = lowest_failure(mpi->Comm(), (bool)failed, status, what);
+  if (first < 0) return;
+  if (first == comm.MyPID()) std::rethrow_exception(failed);
+  throw_as(status, "on rank " + std::to_string(first) + " of " +
+                       std::to_string(comm.NumProc()) + ": " + what);
 }
 
 }  // namespace sp

@@ -8,6 +8,7 @@
 
 #include <mpi.h>
 
+#include <exception>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -43,6 +44,16 @@ inline void check_mpi(int code, const char *call) {
   MPI_Error_string(code, text, &len);
   throw mpi_error(std::string("MPI: ") + call + " failed: " + text);
 }
+
+// The class of the exception @p e as the C door reports it (an
+// sp_solver_status: SP_SOLVER_ERR_INPUT, _MEMORY, _MPI, _INTERNAL or
+// _SOLVER) and its message in @p what.
+int error_status(std::exception_ptr e, std::string &what);
+
+// Collective on @p comm: the lowest rank whose @p failed is set, or -1 if
+// none; then every rank holds that rank's @p status and @p why. One
+// integer reduction; two broadcasts when a rank failed.
+int lowest_failure(MPI_Comm comm, bool failed, int &status, std::string &why);
 
 // Run @p local, the rank-local part of a step that a collective follows
 // (an element loop before GlobalAssemble or SumAll). If it threw on any

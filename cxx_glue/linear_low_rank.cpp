@@ -4,22 +4,16 @@
 #include <cmath>
 #include <utility>
 
+#include "errors.hpp"
+
 namespace sp {
 
 bool all_agree(MPI_Comm comm, bool ok, std::string &why) {
-  int rank, size;
-  MPI_Comm_rank(comm, &rank);
-  MPI_Comm_size(comm, &size);
-  int mine = ok ? size : rank, first = size;
-  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
-  if (first == size) return true;
-  int len = rank == first ? (int)why.size() : 0;
-  MPI_Bcast(&len, 1, MPI_INT, first, comm);
-  std::string msg(len, ' ');
-  if (rank == first) msg = why;
-  MPI_Bcast(&msg[0], len, MPI_CHAR, first, comm);
-  why = msg.empty() ? "the linear solver failed" : msg;
-  if (size > 1 && first > 0) why += " (rank " + std::to_string(first) + ")";
+  int status = 0;  // (no class here: a failed factorisation or solve)
+  const int first = lowest_failure(comm, !ok, status, why);
+  if (first < 0) return true;
+  if (why.empty()) why = "the linear solver failed";
+  if (first > 0) why += " (rank " + std::to_string(first) + ")";
   return false;
 }
 
