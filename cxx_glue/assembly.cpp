@@ -15,13 +15,14 @@ namespace sp {
 
 namespace {
 
-// The fault hook (src/fault.h): SOFTPACK_FAULT=assembly:RANK fails that
-// rank's residual fills, as if an allocation had failed there.
-void fault_at_assembly(int rank) {
-  if (sp_fault_due(SP_FAULT_ASSEMBLY, rank))
-    throw memory_error("out of memory at assembly on rank " + std::to_string(rank) +
-                       " (fault injected by SOFTPACK_FAULT=assembly:" + std::to_string(rank) +
-                       ")");
+// The fault hook (src/fault.h): SOFTPACK_FAULT=NAME:RANK fails that rank
+// at @p phase (assembly: every residual fill; attach: every layout taken),
+// as if an allocation had failed there.
+void fault_in_glue(sp_fault_phase phase, const char *name, int rank) {
+  if (sp_fault_due(phase, rank))
+    throw memory_error(std::string("out of memory at ") + name + " on rank " +
+                       std::to_string(rank) + " (fault injected by SOFTPACK_FAULT=" + name +
+                       ":" + std::to_string(rank) + ")");
 }
 
 }  // namespace
@@ -54,9 +55,7 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
   long first_node = (long)n_nodes_ * r / P, end_node = (long)n_nodes_ * (r + 1) / P;
   std::vector<int> my_dofs;
   agree_local(comm_, [&] {
-    if (sp_fault_due(SP_FAULT_ATTACH, r))
-      throw memory_error("out of memory at attach on rank " + std::to_string(r) +
-                         " (fault injected by SOFTPACK_FAULT=attach:" + std::to_string(r) + ")");
+    fault_in_glue(SP_FAULT_ATTACH, "attach", r);
     node_start_.assign(layout.node_start, layout.node_start + layout.n_nodes + 1);
     pair_cell_.assign(layout.pair_cell, layout.pair_cell + layout.n_pairs);
     if (mesh.n_nodes != layout.n_nodes)
@@ -248,7 +247,7 @@ void Assembly::residual(const sp_step_data &d, const double *state,
   std::vector<int> rows;
   std::vector<double> vals;
   agree_local(comm_, [&] {
-    fault_at_assembly(comm_.MyPID());
+    fault_in_glue(SP_FAULT_ASSEMBLY, "assembly", comm_.MyPID());
     for (int e : my_elems_) {
       gather(e, d, state, g);
       const int n = 8 * g.n_cells;

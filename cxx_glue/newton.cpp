@@ -284,42 +284,43 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   first_row_ = 0;  // (also right for a rank without rows)
   for (int r = 0; r < comm_.MyPID(); ++r) first_row_ += counts[r];
   n_global_ = g.NumGlobalRows();
-  // Columns sorted by global index within each row: the same arrays for
-  // any number of ranks (Epetra orders a row by local column index, which
-  // depends on the partition, and orderings break ties by entry order).
-  // csr_from_[k]: the position in the Epetra row of sorted entry k.
-  csr_ptr_.assign(1, 0);
-  csr_col_.clear();
-  csr_from_.clear();
-  std::vector<std::pair<int, int>> row;
-  for (int i = 0; i < n; ++i) {
-    int len, *idx;
-    g.ExtractMyRowView(i, len, idx);
-    row.resize(len);
-    for (int k = 0; k < len; ++k) row[k] = {g.ColMap().GID(idx[k]), k};
-    std::sort(row.begin(), row.end());
-    for (const auto &e : row) {
-      csr_col_.push_back(e.first);
-      csr_from_.push_back(e.second);
-    }
-    csr_ptr_.push_back((int)csr_col_.size());
-  }
   // On one process the column map is the row map and Epetra keeps each
-  // row sorted by local index, so its arrays are those rows already: a
-  // backend that only reads them reads the Jacobian's own storage.
-  rows_in_place_ = comm_.NumProc() == 1 && !linear_->overwrites_values() &&
+  // row sorted by local index, so its arrays are the sorted rows already: a
+  // backend that only reads them reads the Jacobian's own storage, and no
+  // copy is made.
+  rows_in_place_ = P == 1 && !linear_->overwrites_values() &&
                    jacobian_matrix->StorageOptimized() &&
                    g.ColMap().NumMyElements() == n_global_;
   for (int k = 0; rows_in_place_ && k < g.ColMap().NumMyElements(); ++k)
     rows_in_place_ = g.ColMap().GID(k) == k;
-  for (int i = 0; rows_in_place_ && i < n; ++i)  // each row's entries in Epetra's order
-    for (int k = csr_ptr_[i]; rows_in_place_ && k < csr_ptr_[i + 1]; ++k)
-      rows_in_place_ = csr_from_[k] == k - csr_ptr_[i];
-  if (rows_in_place_) {
-    std::vector<int>().swap(csr_col_);
-    std::vector<int>().swap(csr_from_);
-    std::vector<double>().swap(csr_val_);
-  } else {
+  for (int i = 0; rows_in_place_ && i < n; ++i) {  // (Epetra's Sorted() is not public)
+    int len, *idx;
+    g.ExtractMyRowView(i, len, idx);
+    for (int k = 1; rows_in_place_ && k < len; ++k) rows_in_place_ = idx[k - 1] < idx[k];
+  }
+  // Else columns sorted by global index within each row: the same arrays
+  // for any number of ranks (Epetra orders a row by local column index,
+  // which depends on the partition, and orderings break ties by entry
+  // order). csr_from_[k]: the position in the Epetra row of sorted entry k.
+  std::vector<int>().swap(csr_ptr_);
+  std::vector<int>().swap(csr_col_);
+  std::vector<int>().swap(csr_from_);
+  std::vector<double>().swap(csr_val_);
+  if (!rows_in_place_) {
+    csr_ptr_.assign(1, 0);
+    std::vector<std::pair<int, int>> row;
+    for (int i = 0; i < n; ++i) {
+      int len, *idx;
+      g.ExtractMyRowView(i, len, idx);
+      row.resize(len);
+      for (int k = 0; k < len; ++k) row[k] = {g.ColMap().GID(idx[k]), k};
+      std::sort(row.begin(), row.end());
+      for (const auto &e : row) {
+        csr_col_.push_back(e.first);
+        csr_from_.push_back(e.second);
+      }
+      csr_ptr_.push_back((int)csr_col_.size());
+    }
     csr_val_.assign(csr_col_.size(), 0.0);
   }
   pattern_changed_ = true;
@@ -403,7 +404,7 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
   const bool fresh = jacobian_fresh_;
   if (fresh) {
     double t0 = now();
-    const int n = (int)csr_ptr_.size() - 1;
+    const int n = jacobian_matrix->NumMyRows();
     CsrRows A;
     A.n_global = n_global_;
     A.first_row = first_row_;
