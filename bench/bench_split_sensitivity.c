@@ -4,8 +4,9 @@
  * restored mass), the parent's centre and axis as the division saw them,
  * and the child's mass when the line is moved by s along its normal:
  *     M(s) = sum over the parent's nodes of w_i c_i H(sd_i - s)
- * (H the sharp cut of sp_division_split: 1 beyond the line, 0 before it,
- * 1/2 on it; w_i the node weights of the observables). M is a staircase:
+ * (H = sp_division_child_share, the cut of sp_division_split: sharp, 1
+ * beyond the line, 0 before it, 1/2 on it; w_i the node weights of the
+ * observables). M is a staircase:
  * it jumps by w_i c_i wherever the line crosses a node. A line that runs
  * along a column of nodes crosses the whole column within a tiny offset,
  * so there the split is nearly discontinuous in the parent's state. The
@@ -52,11 +53,6 @@ static char *scene_from_vtu(const char *scene_path, const char *vtu) {
   return text;
 }
 
-static double share(double sd, int smooth, double width, double on_line) {
-  if (smooth) return 1.0 / (1.0 + exp(-sd / width));
-  return sd > on_line ? 1.0 : sd < -on_line ? 0.0 : 0.5;
-}
-
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   if (argc < 3) {
@@ -95,12 +91,14 @@ int main(int argc, char **argv) {
   }
   double px, py, dx, dy;
   sp_division_axis(&obs, &px, &py, &dx, &dy);
-  const double nx = -dy, ny = dx, on_line = 1e-9 * mesh->h;
+  const double nx = -dy, ny = dx, on_line = SP_DIVISION_ON_LINE_FRACTION * mesh->h;
   const double width = sp_scene_interface_width(scene);
-  for (int i = 0; i < nn; ++i) sd[i] = nx * (mesh->xy[2 * i] - px) + ny * (mesh->xy[2 * i + 1] - py);
+  for (int i = 0; i < nn; ++i)
+    sd[i] = nx * (mesh->xy[2 * i] - px) + ny * (mesh->xy[2 * i + 1] - py);
   double m0[2] = {0, 0};
   for (int s = 0; s < 2; ++s)
-    for (int i = 0; i < nn; ++i) m0[s] += w[i] * parent[2 * i] * share(sd[i], s, width, on_line);
+    for (int i = 0; i < nn; ++i)
+      m0[s] += w[i] * parent[2 * i] * sp_division_child_share(sd[i], s, width, on_line);
   printf("%s, %s: parent = cells %d + %d, mass %.8f, centre (%.4e, %.4e), axis angle %.8f "
          "(pi/2 %+.3e), mesh h %.4g; child mass at the line: sharp %.8f, smooth %.8f\n",
          argv[1], argv[2], a + 1, b + 1, obs.mass, px, py, obs.angle, obs.angle - M_PI / 2,
@@ -112,9 +110,9 @@ int main(int argc, char **argv) {
     int near = 0;
     for (int i = 0; i < nn; ++i) {
       const double wc = w[i] * parent[2 * i];
-      m[0] += wc * share(sd[i] - s, 0, width, on_line);
-      m[1] += wc * share(sd[i] + s, 0, width, on_line);
-      m[2] += wc * share(sd[i] - s, 1, width, on_line);
+      m[0] += wc * sp_division_child_share(sd[i] - s, 0, width, on_line);
+      m[1] += wc * sp_division_child_share(sd[i] + s, 0, width, on_line);
+      m[2] += wc * sp_division_child_share(sd[i] - s, 1, width, on_line);
       near += fabs(sd[i]) <= s && parent[2 * i] >= 0.5;
     }
     printf("| %.1e | %d | %+.3e | %.1e | %+.3e | %+.3e | %.1e |\n", s, near, m[0] - m0[0],

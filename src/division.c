@@ -5,10 +5,6 @@
 
 #include "error.h"
 
-/** A node within this fraction of the mesh size h of the division line is
- *  "on" it for the sharp cut (round-off in the centre of mass is ~1e-16). */
-#define SP_DIVISION_ON_LINE_FRACTION 1e-9
-
 /** Relative slack of sp_division_max_cells' rounding down. */
 #define SP_DIVISION_MAX_CELLS_SLACK 1e-9
 
@@ -98,8 +94,7 @@ void sp_division_axis(const sp_cell_obs *obs, double *px, double *py, double *dx
   *dy = obs->v1[1];
 }
 
-/** The child's share H(sd) of the parent's value at signed distance sd. */
-static double child_share(double sd, int smooth, double width, double on_line) {
+double sp_division_child_share(double sd, int smooth, double width, double on_line) {
   if (smooth) return 1.0 / (1.0 + exp(-sd / width));
   if (sd > on_line) return 1.0;
   if (sd < -on_line) return 0.0;
@@ -137,7 +132,7 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
     if (p_old < 0) continue;
     const double sd =
         nx * (mesh->xy[2 * i] - px) + ny * (mesh->xy[2 * i + 1] - py) - offset;
-    const double share = child_share(sd, smooth, width, on_line);
+    const double share = sp_division_child_share(sd, smooth, width, on_line);
     const double c = state[2 * p_old], mu = state[2 * p_old + 1];
     /* parent = c - child, not c (1 - H): the two then add up to c. */
     const double c_child = c * share, c_parent = c - c_child;
@@ -176,7 +171,8 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
 static double child_mass(int n, const double *w, const double *c, const double *sd,
                          double s, int smooth, double width, double on_line) {
   double m = 0;
-  for (int j = 0; j < n; ++j) m += w[j] * c[j] * child_share(sd[j] - s, smooth, width, on_line);
+  for (int j = 0; j < n; ++j)
+    m += w[j] * c[j] * sp_division_child_share(sd[j] - s, smooth, width, on_line);
   return m;
 }
 

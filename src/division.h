@@ -140,6 +140,16 @@ double sp_division_crossing_fraction(const sp_division_params *params,
                                      double t_new, double mass_old,
                                      double mass_new);
 
+/** A node within this fraction of the mesh size h of the division line is
+ *  "on" it for the sharp cut (round-off in the centre of mass is ~1e-16). */
+#define SP_DIVISION_ON_LINE_FRACTION 1e-9
+
+/** @brief The child's share H(sd) of the parent's value at a node at
+ *         signed distance @p sd from the division line: the sharp cut (1
+ *         beyond the line, 0 before it, 1/2 within @p on_line of it) or the
+ *         smoothed one (a logistic of width @p width). */
+double sp_division_child_share(double sd, int smooth, double width, double on_line);
+
 /**
  * @brief The division line of a cell: through its centre of mass along v1,
  *        the unit eigenvector of the LARGEST principal moment I1 (MODEL.md).
