@@ -61,9 +61,10 @@ defaults_of() {
       $2 == k { gsub(/`/, "", $2); print "--set"; print $2 "=" $5 }'
   done
 }
-mapfile -t fast < <(defaults_of solver.linear solver.predictor solver.jacobian_reuse)
+mapfile -t fast < <(defaults_of solver.linear solver.predictor solver.jacobian_reuse \
+                      solver.jacobian_carry)
 mapfile -t defaults < <(defaults_of time.control time.scheme time.rtol time.atol)
-[ ${#fast[@]} = 6 ] && [ ${#defaults[@]} = 8 ] ||
+[ ${#fast[@]} = 8 ] && [ ${#defaults[@]} = 8 ] ||
   { echo "bench/work_precision.sh: cannot read the defaults from softpack keys" >&2; exit 2; }
 solver=("${fast[@]}" "${solver[@]}")
 

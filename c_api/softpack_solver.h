@@ -83,8 +83,15 @@ typedef struct {
   /** Modified Newton: an iteration keeps the last Jacobian and its
    *  factorisation when the previous iteration cut ||F|| at least this
    *  much (||F_k|| <= jacobian_reuse ||F_k-1||); the first iteration of a
-   *  step always has a fresh one. 0: a new Jacobian every iteration. */
+   *  step has a fresh one unless jacobian_carry keeps the last step's.
+   *  0: a new Jacobian every iteration (Newton's method). */
   double jacobian_reuse;
+  /** With jacobian_reuse > 0: a step begins on the last step's
+   *  factorisation (same layout, the last step converged) and keeps it
+   *  while each iteration cuts ||F|| by at least this factor; the first
+   *  iteration that does not gets a fresh Jacobian. 0: every step begins
+   *  with a fresh Jacobian. */
+  double jacobian_carry;
   /** A step fails as soon as an iteration's ||F_k|| exceeds this multiple
    *  of the step's first ||F_0|| (it is retried with a smaller dt without
    *  spending the rest of newton_max_its). 0: off; otherwise > 1. */
@@ -168,6 +175,12 @@ typedef struct {
   const sp_shape_coef *shape; /**< per cell (NULL: no shape term) */
   int shape_implicit;         /**< 1: shape coefficients follow the new
                                    state's moments through gain */
+  /** Newton also converges (after at least one update) once every c entry
+   *  of the last update is at most update_atol + update_rtol |c|: the
+   *  adaptive time control's tolerances scaled down, so Newton's error is a
+   *  small part of the step's (mu is algebraic: it follows c). 0, 0: off,
+   *  the residual tolerances alone. */
+  double update_rtol, update_atol;
 } sp_step_data;
 
 /** Why a Newton solve failed (sp_step_report.failure). */
@@ -219,11 +232,28 @@ int sp_solver_ranks(sp_solver s);
 int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh,
                           const sp_layout_view *layout);
 
-/** @brief The next factorisation starts from scratch (ordering, symbolic
- *         analysis, a direct solver's row permutation), as after a new
- *         layout: after a checkpoint, so that a run continued from it
- *         factorises exactly as the run that wrote it goes on to. */
-int sp_solver_refactor_next(sp_solver s);
+/**
+ * @brief Whether the next step may begin on the current factorisation
+ *        (solver.jacobian_carry), and where its Jacobian was filled: for a
+ *        checkpoint, so a continued run rebuilds it (sp_solver_carry_restore)
+ *        and goes on as the run that wrote it.
+ * @param carry 1: it may (then the rest is set), 0: the next step begins
+ *        with a new Jacobian
+ * @param dt the step's dt (dt_eff for BDF2) at the fill
+ * @param x the full state (layout order, 2 n_pairs values), owned by the
+ *        solver, valid until its next step
+ * @param shape the step's shape coefficients, n_shape of them (0: none),
+ *        owned by the solver; @p shape_implicit their mode
+ */
+int sp_solver_carry_point(sp_solver s, int *carry, double *dt, const double **x,
+                          const sp_shape_coef **shape, int *n_shape, int *shape_implicit);
+
+/**
+ * @brief Fill the Jacobian at @p x with @p data (dt, model, shape as at the
+ *        fill sp_solver_carry_point described) and factor it: the next step
+ *        may begin on it. Collective.
+ */
+int sp_solver_carry_restore(sp_solver s, const sp_step_data *data, const double *x);
 
 /**
  * @brief One backward-Euler step by Newton. On entry @p state is the initial

@@ -113,11 +113,28 @@ int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh, const sp_layout
   });
 }
 
-int sp_solver_refactor_next(sp_solver s) {
+int sp_solver_carry_point(sp_solver s, int *carry, double *dt, const double **x,
+                          const sp_shape_coef **shape, int *n_shape, int *shape_implicit) {
   if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {
     need(s->impl != nullptr, "the solver was not created");
-    s->impl->refactor_next();
+    need(carry && dt && x && shape && n_shape && shape_implicit,
+         "sp_solver_carry_point: null argument");
+    const std::vector<double> *xs;
+    const std::vector<sp_shape_coef> *coefs;
+    *carry = s->impl->carry_point(*dt, xs, coefs, *shape_implicit) ? 1 : 0;
+    *x = xs->data();
+    *shape = coefs->empty() ? nullptr : coefs->data();
+    *n_shape = (int)coefs->size();
+  });
+}
+
+int sp_solver_carry_restore(sp_solver s, const sp_step_data *data, const double *x) {
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
+  return guarded(s, [&] {
+    need(s->impl != nullptr, "the solver was not created");
+    need(data && x && data->dt > 0, "sp_solver_carry_restore: null argument or dt <= 0");
+    s->impl->carry_restore(*data, x);
   });
 }
 

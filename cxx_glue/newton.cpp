@@ -160,6 +160,40 @@ class AtLeastOneIteration : public ConditionTest {
   }
 };
 
+// Converged (with at least one update) once every c entry of the last
+// update is within update_atol + update_rtol |c| (sp_step_data): the time
+// control's tolerance, scaled down, decides how exactly a step is solved.
+// The state is (c, mu) per pair: even global indices are c.
+class UpdateSmall : public ConditionTest {
+ public:
+  UpdateSmall(MPI_Comm comm, double rtol, double atol)
+      : ConditionTest(NOX::StatusTest::Converged, "|dc| <= update_atol + update_rtol |c|"),
+        comm_(comm), rtol_(rtol), atol_(atol) {}
+
+ protected:
+  bool holds(const NOX::Solver::Generic &solver) const override {
+    if (solver.getNumIterations() < 1) return false;
+    const auto &x = dynamic_cast<const NOX::Epetra::Vector &>(solver.getSolutionGroup().getX())
+                        .getEpetraVector();
+    const auto &xp = dynamic_cast<const NOX::Epetra::Vector &>(
+                         solver.getPreviousSolutionGroup().getX()).getEpetraVector();
+    double worst = 0;  // (a NaN sticks, and fails)
+    for (int i = 0; i < x.MyLength(); ++i) {
+      if (x.Map().GID(i) % 2 != 0) continue;
+      const double e = std::fabs(x[i] - xp[i]) / (atol_ + rtol_ * std::fabs(x[i]));
+      if (!(e <= worst)) worst = e;
+    }
+    int nan = std::isnan(worst) ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, comm_);
+    MPI_Allreduce(MPI_IN_PLACE, &nan, 1, MPI_INT, MPI_MAX, comm_);
+    return !nan && worst <= 1;
+  }
+
+ private:
+  MPI_Comm comm_;
+  double rtol_, atol_;
+};
+
 // Modified Newton's iteration limit: this many factorisations (each
 // iteration that reused one was cheap, and followed one that cut ||F|| by
 // jacobian_reuse).
@@ -209,6 +243,8 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     throw input_error("solver.jacobian: unknown kind");
   if (!(options.jacobian_reuse >= 0 && options.jacobian_reuse < 1))
     throw input_error("solver.jacobian_reuse: expected 0 <= value < 1");
+  if (!(options.jacobian_carry >= 0 && options.jacobian_carry < 1))
+    throw input_error("solver.jacobian_carry: expected 0 <= value < 1");
   if (options.ordering != SP_SOLVER_ORDER_PAIRS && options.ordering != SP_SOLVER_ORDER_UNKNOWNS)
     throw input_error("solver.ordering: unknown kind");
   if (options.line_search != SP_SOLVER_STEP_FULL && options.line_search != SP_SOLVER_STEP_BACKTRACK)
@@ -358,6 +394,13 @@ void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
   assembly_->jacobian(shape_.data_at(d, *assembly_, full_.data()), full_.data(),
                       options_.jacobian, *jacobian_matrix);
   jacobian_fresh_ = true;
+  if (options_.jacobian_reuse > 0 && options_.jacobian_carry > 0) {
+    jac_x_ = full_;
+    jac_dt_ = d.dt;
+    jac_shape_implicit_ = d.shape_implicit;
+    if (d.shape) jac_shape_.assign(d.shape, d.shape + assembly_->n_cells());
+    else jac_shape_.clear();
+  }
   t_assembly += now() - t0;
 }
 
@@ -392,17 +435,48 @@ void Solver::jacobian_times(const sp_step_data &d, const double *state, bool tra
   std::copy(full.begin(), full.end(), y);
 }
 
-bool Solver::may_reuse_jacobian() const {
-  const size_t n = step_norms_.size();
-  // The norms are global, so every rank decides alike.
-  return options_.jacobian_reuse > 0 && step_factorisations_ > 0 && !jacobian_fresh_ &&
-         !pattern_changed_ && n >= 2 &&
-         step_norms_[n - 1] <= options_.jacobian_reuse * step_norms_[n - 2];
+bool Solver::carry_point(double &dt, const std::vector<double> *&x,
+                         const std::vector<sp_shape_coef> *&shape, int &shape_implicit) const {
+  dt = jac_dt_;
+  x = &jac_x_;
+  shape = &jac_shape_;
+  shape_implicit = jac_shape_implicit_;
+  return options_.jacobian_reuse > 0 && options_.jacobian_carry > 0 && last_converged_ &&
+         !pattern_changed_ && !jacobian_fresh_ && !jac_x_.empty();
 }
 
-bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
-  const bool fresh = jacobian_fresh_;
-  if (fresh) {
+void Solver::carry_restore(const sp_step_data &d, const double *x) {
+  require_problem();
+  if (!(options_.jacobian_reuse > 0 && options_.jacobian_carry > 0))
+    return;  // (a continued run with the carry switched off: nothing to carry)
+  const Epetra_Map &map = assembly_->map();
+  Epetra_Vector xv(map);
+  for (int i = 0; i < map.NumMyElements(); ++i) xv[i] = x[map.GID(i)];
+  prepare_shape(d);
+  fill_jacobian(d, xv);
+  std::string why;
+  if (!factor_jacobian(why))  // (agreed inside)
+    throw std::runtime_error("rebuilding the carried factorisation: " + why);
+  step_factorisations_ = 0;
+  last_converged_ = true;
+}
+
+bool Solver::may_reuse_jacobian() const {
+  const size_t n = step_norms_.size();
+  if (options_.jacobian_reuse <= 0 || jacobian_fresh_ || pattern_changed_) return false;
+  // The step's first iteration: on the last step's factorisation if carried.
+  if (step_factorisations_ == 0 && n == 1) return carried_;
+  // Later ones keep the factorisation while the last iteration cut ||F|| by
+  // jacobian_reuse (by jacobian_carry while it is still the carried one).
+  // The norms are global, so every rank decides alike.
+  const double theta = step_factorisations_ == 0 ? options_.jacobian_carry
+                                                 : options_.jacobian_reuse;
+  return (step_factorisations_ > 0 || carried_) && n >= 2 &&
+         step_norms_[n - 1] <= theta * step_norms_[n - 2];
+}
+
+bool Solver::factor_jacobian(std::string &why) {
+  {
     double t0 = now();
     const int n = jacobian_matrix->NumMyRows();
     CsrRows A;
@@ -441,6 +515,12 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
     jacobian_fresh_ = false;
     ++step_factorisations_;
   }
+  return true;
+}
+
+bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
+  const bool fresh = jacobian_fresh_;
+  if (fresh && !factor_jacobian(why)) return false;
   // (the first solve after a factorisation also does the low-rank term's
   // block solve and small factorisation: counted as solve time)
   double t0 = now();
@@ -463,6 +543,12 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   for (int i = 0; i < map.NumMyElements(); ++i) x0[i] = state[map.GID(i)];
 
   prepare_shape(d);
+  // Carry the last step's factorisation: same layout, the last step
+  // converged, no low-rank term (its Woodbury factors belong to the last
+  // step's shape coefficients); the first iteration's contraction decides.
+  carried_ = options_.jacobian_reuse > 0 && options_.jacobian_carry > 0 && last_converged_ &&
+             !pattern_changed_ && !jacobian_fresh_ && linear_->term().empty();
+  last_converged_ = false;
   auto iface = Teuchos::rcp(new StepInterface(*this, d));
   auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *iface));
   auto params = Teuchos::rcp(new Teuchos::ParameterList);
@@ -496,6 +582,12 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   auto tolerance = Teuchos::rcp(new Combo(Combo::OR));
   tolerance->addStatusTest(Teuchos::rcp(new NormF(options_.newton_atol, NormF::Unscaled)));
   tolerance->addStatusTest(Teuchos::rcp(new NormF(*group, options_.newton_rtol, NormF::Unscaled)));
+  if (!(d.update_rtol >= 0 && d.update_atol >= 0) ||
+      (d.update_rtol > 0 && !(d.update_atol > 0)))
+    throw input_error("sp_step_data: expected update_atol > 0 with update_rtol > 0, both >= 0");
+  if (d.update_rtol > 0 || d.update_atol > 0)
+    tolerance->addStatusTest(
+        Teuchos::rcp(new UpdateSmall(comm_.Comm(), d.update_rtol, d.update_atol)));
   converged->addStatusTest(tolerance);
   converged->addStatusTest(Teuchos::rcp(new AtLeastOneIteration));
   auto all = Teuchos::rcp(new Combo(Combo::OR));
@@ -547,6 +639,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
     gather(xs, full_);
     std::copy(full_.begin(), full_.end(), state);
     report.converged = 1;
+    last_converged_ = true;
     report.t_total = now() - t_start;
     return 0;
   }

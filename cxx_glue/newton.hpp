@@ -26,8 +26,14 @@ class Solver {
   Solver(MPI_Comm comm, const sp_solver_options &options);
 
   void set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout);
-  /// The next factorisation from scratch, as after a new layout.
-  void refactor_next() { pattern_changed_ = true; }
+  /// Whether the next step may begin on the current factorisation
+  /// (jacobian_carry), and the point its Jacobian was filled at: dt, the
+  /// full state, the step's shape coefficients (for a checkpoint).
+  bool carry_point(double &dt, const std::vector<double> *&x,
+                   const std::vector<sp_shape_coef> *&shape, int &shape_implicit) const;
+  /// Fill the Jacobian at x with d and factor it: the next step may begin
+  /// on it, as in the run whose carry_point this is.
+  void carry_restore(const sp_step_data &d, const double *x);
   int ranks() const { return comm_.NumProc(); }
   // Returns 0 when converged, 1 when Newton failed (state restored).
   int step(const sp_step_data &data, double *state, sp_step_report &report);
@@ -90,6 +96,18 @@ class Solver {
   bool jacobian_fresh_ = false;  // the matrix changed since the last factor
   bool pattern_changed_ = true;  // the layout changed since the last factor
   int step_factorisations_ = 0;  // factorisations in the current step
+  // Across steps (sp_solver_options.jacobian_carry): whether the last step
+  // converged, and whether this one began on its factorisation.
+  bool last_converged_ = false;
+  bool carried_ = false;
+  // Where the current Jacobian was filled (fill_jacobian): a checkpoint
+  // saves it, so a continued run rebuilds the factorisation it carries.
+  double jac_dt_ = 0;
+  int jac_shape_implicit_ = 0;
+  std::vector<double> jac_x_;
+  std::vector<sp_shape_coef> jac_shape_;
+  // Factor jacobian_matrix (solve_linear's first part); false: why says.
+  bool factor_jacobian(std::string &why);
   std::vector<double> step_norms_;  // ||F|| at the guess and after each iteration
   std::vector<double> full_;     // scratch: the replicated state
   ImplicitShape shape_;          // the current step's implicit shape term

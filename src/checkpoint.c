@@ -13,6 +13,7 @@
 
 #include "build_info.h"
 #include "error.h"
+#include "solver_status.h"
 
 #define SP_CHECKPOINT_FORMAT "softpack checkpoint"
 
@@ -175,6 +176,32 @@ enum { H_STEP, H_N_MAX, H_MPI_SIZE, H_N_CELLS, H_HIST_N, H_N_ENERGY, H_N_DIVISIO
 enum { H_T, H_DT0, H_DT1, HEADER_DOUBLES };
 
 /** Write the whole state into the open file @p f; nonzero on an HDF5 error. */
+/** sp_shape_coef as doubles in /carry/shape. */
+enum { SHAPE_DOUBLES = sizeof(sp_shape_coef) / sizeof(double) };
+_Static_assert(sizeof(sp_shape_coef) == SHAPE_DOUBLES * sizeof(double),
+               "sp_shape_coef holds doubles only");
+
+/** /carry: where the factorisation the next step begins on was filled. */
+static int put_carry(hid_t f, const sp_run *run) {
+  int carry = 0, n_shape = 0, shape_implicit = 0;
+  double dt = 0;
+  const double *x = NULL;
+  const sp_shape_coef *shape = NULL;
+  if (run->solver && sp_solver_carry_point(run->solver, &carry, &dt, &x, &shape, &n_shape,
+                                           &shape_implicit) != SP_SOLVER_OK)
+    return 1;
+  const int header[3] = {carry, carry ? n_shape : 0, shape_implicit};
+  int bad = make_group(f, "/carry");
+  bad |= put_array(f, "/carry/header", H5T_NATIVE_INT, header, 3);
+  if (!carry) return bad;
+  bad |= put_array(f, "/carry/dt", H5T_NATIVE_DOUBLE, &dt, 1);
+  bad |= put_array(f, "/carry/x", H5T_NATIVE_DOUBLE, x, 2 * (size_t)run->layout->n_pairs);
+  if (n_shape > 0)
+    bad |= put_array(f, "/carry/shape", H5T_NATIVE_DOUBLE, shape,
+                     SHAPE_DOUBLES * (size_t)n_shape);
+  return bad;
+}
+
 static int write_state(hid_t f, const sp_run *run) {
   const sp_layout *ly = run->layout;
   const size_t n_pairs = (size_t)ly->n_pairs, nc = (size_t)ly->n_cells;
@@ -251,6 +278,7 @@ static int write_state(hid_t f, const sp_run *run) {
                    run->n_energy);
   bad |= put_array(f, "/output/division_t", H5T_NATIVE_DOUBLE, run->division_t,
                    run->n_divisions);
+  bad |= put_carry(f, run);
   const sp_output_field *fields = NULL;
   const int n_fields = run->output ? sp_output_fields_list(run->output, &fields) : 0;
   if (n_fields > 0) {
@@ -733,4 +761,37 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
   SP_CALL(read_doubles(ck, "/output/division_t", &run->division_t, n_div));
   run->n_divisions = n_div;
   return read_fields_list(ck, fields, n_fields);
+}
+
+int sp_checkpoint_restore_carry(const sp_checkpoint ck, sp_run *run) {
+  if (H5LTpath_valid(ck->file, "/carry/header", 1) <= 0) return SP_OK; /* an older file */
+  int header[3];
+  SP_CALL(get_array(ck, "/carry/header", H5T_NATIVE_INT, header, 3));
+  const int carry = header[0], n_shape = header[1];
+  SP_CHECK((carry == 0 || carry == 1) && n_shape >= 0 &&
+               (n_shape == 0 || n_shape == run->layout->n_cells),
+           SP_ERR_INPUT, "checkpoint '%s': /carry damaged", ck->path);
+  if (!carry) return SP_OK;
+  const size_t n_values = 2 * (size_t)run->layout->n_pairs;
+  double dt = 0;
+  double *x = malloc(sizeof(double) * n_values + 1);
+  sp_shape_coef *shape = n_shape ? malloc(sizeof *shape * (size_t)n_shape) : NULL;
+  int rc = x && (shape || !n_shape) ? SP_OK : sp_error_set(SP_ERR_MEMORY, "out of memory");
+  if (rc == SP_OK) rc = get_array(ck, "/carry/dt", H5T_NATIVE_DOUBLE, &dt, 1);
+  if (rc == SP_OK) rc = get_array(ck, "/carry/x", H5T_NATIVE_DOUBLE, x, n_values);
+  if (rc == SP_OK && n_shape)
+    rc = get_array(ck, "/carry/shape", H5T_NATIVE_DOUBLE, shape, SHAPE_DOUBLES * (size_t)n_shape);
+  if (rc == SP_OK && !(dt > 0))
+    rc = sp_error_set(SP_ERR_INPUT, "checkpoint '%s': /carry/dt damaged", ck->path);
+  if (rc == SP_OK) {
+    const sp_step_data data = {.dt = dt, .model = run->model, .state_old = x, .shape = shape,
+                               .shape_implicit = header[2]};
+    const int status = sp_solver_carry_restore(run->solver, &data, x);
+    if (status != SP_SOLVER_OK)
+      rc = sp_solver_failed(run->solver, status, "checkpoint '%s': the carried factorisation",
+                            ck->path);
+  }
+  free(x);
+  free(shape);
+  return rc;
 }

@@ -23,9 +23,15 @@
  *   /summary          the run's counters (stepper.h: sp_run_summary)
  *   /output           energy_t, energy_total (energy.png), division_t,
  *                     field_step, field_t, field_pvtu (fields.pvd)
+ *   /carry            header (carry, n_shape, shape_implicit); with carry = 1
+ *                     dt, x (2 n_pairs), shape (13 per cell, or none): where
+ *                     the factorisation the next step begins on
+ *                     (solver.jacobian_carry) was filled, so a continued
+ *                     run rebuilds it (absent in older files: no carry)
  *
  * The mesh, its RCB numbering, the solver and the supports' search
- * structures are rebuilt from the scene; there is no random state after the
+ * structures are rebuilt from the scene (the carried factorisation from
+ * /carry); there is no random state after the
  * initial fields (the seeded noise is drawn once).
  */
 #ifndef SP_CHECKPOINT_H
@@ -87,6 +93,13 @@ void sp_checkpoint_cells(const sp_checkpoint ck, int *n_cells, int *n_max);
  */
 int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
                           sp_output_field **fields, int *n_fields);
+
+/**
+ * @brief Rebuild the factorisation the next step of the checkpointed run
+ *        began on (/carry), on the solver that has the restored layout.
+ *        Nothing to do without one. Collective.
+ */
+int sp_checkpoint_restore_carry(const sp_checkpoint ck, sp_run *run);
 
 void sp_checkpoint_close(sp_checkpoint *ck);
 

@@ -44,6 +44,7 @@ int sp_dt_newton_failed(sp_dt_control *c, double dt) {
     c->ceiling_steps = c->p.failure_memory;
   }
   c->rejected_last = 1;
+  c->rejected_dt = c->rejected_err = 0; /* (judge's exponent: rejections only) */
   return sp_dt_give_up(c);
 }
 
@@ -59,19 +60,31 @@ static double pi_factor(const sp_dt_control *c, double err) {
 
 sp_dt_verdict sp_dt_judge(sp_dt_control *c, double dt, double err) {
   if (c->p.policy == SP_DT_FIXED || err <= 1) return SP_DT_ACCEPT; /* NaN rejects */
-  const double k = c->p.order + 1;
-  double f = isfinite(err) ? SP_DT_SAFETY * pow(err, -1.0 / k) : SP_DT_CUT_MIN;
+  double k = c->p.order + 1;
+  /* A second rejection of the step: the estimate's exponent as observed
+   * over the two attempts, when it is below the method's (the estimate is
+   * dominated by something that does not scale as dt^k, e.g. a transient
+   * after a support change). 0 < exponent: as observed; no decrease: the
+   * largest cut. */
+  if (c->rejected_dt > dt && isfinite(err)) {
+    const double q = log(c->rejected_err / err) / log(c->rejected_dt / dt);
+    k = q > 0 ? fmin(q, k) : 0;
+  }
+  double f = isfinite(err) && k > 0 ? SP_DT_SAFETY * pow(err, -1.0 / k) : SP_DT_CUT_MIN;
   f = fmin(fmax(f, SP_DT_CUT_MIN), SP_DT_SAFETY);
   ++c->failures;
   ++c->n_rejected;
   c->dt_next = dt * f;
   c->rejected_last = 1;
+  c->rejected_dt = isfinite(err) ? dt : 0;
+  c->rejected_err = isfinite(err) ? err : 0;
   return SP_DT_REJECT;
 }
 
 void sp_dt_accepted(sp_dt_control *c, double dt, double err) {
   ++c->n_accepted;
   c->failures = 0;
+  c->rejected_dt = c->rejected_err = 0;
   c->dt_last = dt;
   if (c->since_restart >= 0) ++c->since_restart;
   if (c->p.policy == SP_DT_FIXED) { /* today's policy, the paper's runs */
@@ -104,4 +117,5 @@ void sp_dt_restart(sp_dt_control *c, double dt_first) {
   c->dt_next = fmax(fmin(dt_first, c->p.dt_max), c->p.dt_min);
   c->err_prev = 0;
   c->rejected_last = 0;
+  c->rejected_dt = c->rejected_err = 0;
 }

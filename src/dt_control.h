@@ -22,7 +22,11 @@
  * - adaptive: dt from a local error estimate err (a weighted max-norm of
  *   the estimated local error of c, 1 = on tolerance; the time scheme
  *   computes it, time_scheme.h). A step with err > 1 is rejected and
- *   retried with a smaller dt, never accepted. The next dt comes from a PI
+ *   retried with a smaller dt, never accepted: dt x safety x err^(-1/k),
+ *   or, at a second rejection of the same step whose estimate fell more
+ *   slowly than dt^k (a transient that does not scale with dt, such as the
+ *   relaxation after a support change), with the exponent observed over
+ *   the two attempts. The next dt comes from a PI
  *   controller, dt_new = dt * safety * err^(-0.7/k) * err_prev^(0.4/k)
  *   (k = the estimate's order + 1), bounded by SP_DT_GROW_MAX and
  *   SP_DT_CUT_MIN and by [dt_min, dt_max]. The first step (and the first
@@ -88,6 +92,9 @@ typedef struct {
   double err_prev;    /**< adaptive: the last accepted step's estimate (0: none) */
   double dt_last;     /**< the last accepted step (0: none yet) */
   int rejected_last;  /**< adaptive: the last attempt was rejected */
+  double rejected_dt, rejected_err; /**< adaptive: the last rejected attempt of
+                                         the step in progress (0: none; so 0
+                                         between steps, never checkpointed) */
   long n_accepted, n_rejected, n_newton_failed;
 } sp_dt_control;
 

@@ -180,6 +180,7 @@ static int setup(sp_run *run, MPI_Comm comm, const sp_run_start *start) {
     SP_CALL(rc);
     run->restarted = !start->as_initial;
     SP_CALL(layout_taken(run)); /* the checkpoint's layout, history with it */
+    if (!start->as_initial) SP_CALL(sp_checkpoint_restore_carry(start->checkpoint, run));
     if (start->as_initial) { /* observes too */
       SP_CALL(new_registry(run));
       reference_mass = run->birth[0].birth_mass;

@@ -267,9 +267,9 @@ static const sp_key sp_keys[] = {
              "time scheme: backward Euler (be, the paper's) or variable-step "
              "BDF2 (bdf2, second order; BE after the start and each "
              "division)"),
-    KEY_FLOAT(SP_SEC_TIME, "rtol", time.rtol, 1e-1, ABOVE(0.0), UNBOUNDED, "-",
+    KEY_FLOAT(SP_SEC_TIME, "rtol", time.rtol, 1e-2, ABOVE(0.0), UNBOUNDED, "-",
               "adaptive: relative tolerance of a step's local error in c"),
-    KEY_FLOAT(SP_SEC_TIME, "atol", time.atol, 1e-1, ABOVE(0.0), UNBOUNDED, "-",
+    KEY_FLOAT(SP_SEC_TIME, "atol", time.atol, 1e-2, ABOVE(0.0), UNBOUNDED, "-",
               "adaptive: absolute tolerance of a step's local error in c"),
     KEY_FLOAT(SP_SEC_TIME, "dt_max", time.dt_max, 1.0, ABOVE(0.0), UNBOUNDED,
               "T", "adaptive: the largest step (must be >= dt_min)"),
@@ -320,7 +320,9 @@ static const sp_key sp_keys[] = {
              "(gmres_ilu)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
               ABOVE(0.0), BELOW(1.0), "-",
-              "Newton: residual reduction relative to the first residual"),
+              "Newton: residual reduction relative to the first residual (with "
+              "time.control adaptive Newton also stops once its update of c is "
+              "below 1% of time.rtol and time.atol)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_atol", solver.newton_atol, 1e-10,
               ABOVE(0.0), UNBOUNDED, "-",
               "Newton: absolute residual (unscaled 2-norm)"),
@@ -333,6 +335,12 @@ static const sp_key sp_keys[] = {
               "modified Newton: an iteration keeps the last Jacobian and its "
               "factorisation while the previous one cut the residual norm by "
               "at least this factor (0: a new Jacobian every iteration)"),
+    KEY_FLOAT(SP_SEC_SOLVER, "jacobian_carry", solver.jacobian_carry, 0.35,
+              AT_LEAST(0.0), BELOW(1.0), "-",
+              "with jacobian_reuse > 0: a step begins on the last step's "
+              "factorisation and keeps it while each iteration cuts the "
+              "residual norm by at least this factor (0: every step begins "
+              "with a new Jacobian)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_divergence", solver.newton_divergence, 0.0,
               AT_LEAST(0.0), UNBOUNDED, "-",
               "a step fails (and is retried with a smaller dt) as soon as an "

@@ -103,6 +103,8 @@ typedef struct {
   double krylov_tol;   /**< gmres_ilu: relative residual of a linear solve */
   double jacobian_reuse; /**< modified Newton: keep the factorisation while
                               each iteration cuts ||F|| by this (0: never) */
+  double jacobian_carry; /**< a step begins on the last step's
+                              factorisation while it cuts ||F|| by this */
   double newton_divergence; /**< fail a step once ||F_k|| > this x ||F_0||
                                  (0: off) */
   sp_line_search_kind line_search; /**< the length of a Newton update */

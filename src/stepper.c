@@ -47,6 +47,7 @@ void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt)
   opt->ilu_fill = scene->solver.ilu_fill;
   opt->krylov_tol = scene->solver.krylov_tol;
   opt->jacobian_reuse = scene->solver.jacobian_reuse;
+  opt->jacobian_carry = scene->solver.jacobian_carry;
   opt->newton_divergence = scene->solver.newton_divergence;
   opt->ordering = scene->solver.ordering == SP_ORDER_PAIRS ? SP_SOLVER_ORDER_PAIRS
                                                            : SP_SOLVER_ORDER_UNKNOWNS;
@@ -436,10 +437,8 @@ static int checkpoint_if_due(sp_run *run, int *signalled) {
   ++run->sum->checkpoints;
   SP_CALL(sp_agree(run->agree_comm, rc)); /* every rank learns whether it was written */
   run->t_checkpoint = wall_clock();
-  /* the next factorisation from scratch, as in a run continued from here
-   * (sets a flag only) */
-  const int status = sp_solver_refactor_next(run->solver);
-  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "solver");
+  /* (the run goes on as if none was written: a run continued from it
+   * rebuilds the factorisation this one carries, from /carry) */
   if (want_stop && run->rank == 0) {
     if (isatty(fileno(stderr))) fputs("\r\033[K", stderr);
     fprintf(stderr, "softpack: stopped on a signal after step %d (t = %.6g): checkpoint %s\n",
@@ -509,6 +508,10 @@ static int run_steps(sp_run *run, sp_run_summary *sum) {
                          .source = run->scene->source.rate > 0 ? run->source : NULL,
                          .shape = shape_coef,
                          .shape_implicit = run->scene->shape.scheme == SP_SHAPE_IMPLICIT};
+    if (adaptive) { /* Newton's error: a small part of the step's */
+      data.update_rtol = SP_SCHEME_NEWTON_FRACTION * tc->rtol;
+      data.update_atol = SP_SCHEME_NEWTON_FRACTION * tc->atol;
+    }
     sp_step_report report;
     int solved = sp_solver_step(run->solver, &data, run->state, &report);
     sum->t_assembly += report.t_assembly;

@@ -43,6 +43,10 @@ extern "C" {
 
 typedef enum { SP_SCHEME_BE = 0, SP_SCHEME_BDF2 = 1 } sp_scheme_kind;
 
+/** Adaptive control: Newton also stops once its last update of c is below
+ *  this fraction of the error tolerance (sp_step_data.update_rtol/atol). */
+#define SP_SCHEME_NEWTON_FRACTION 0.01
+
 /** Safety factor on the convexity bound of the first step. */
 #define SP_SCHEME_FIRST_SAFETY 0.5
 

@@ -199,8 +199,50 @@ static void check_restart(void) {
   CHECK(c.dt_next == SP_DT_RESTART_FRACTION * 3e-6, "restart after 3e-6: dt %g", c.dt_next);
 }
 
+/* A second rejection of a step whose estimate falls more slowly than
+ * dt^k (k = order + 1): the cut uses the exponent observed over the two
+ * attempts. An estimate err = 4 (dt / 1e-3)^(1/2) (BDF2, k = 3) is met
+ * within three rejections; one that scales as dt^3 keeps k; one that does
+ * not fall takes the largest cut; an accepted step forgets. */
+static void check_observed_exponent(void) {
+  sp_dt_control c;
+  sp_dt_params p = adaptive_params(2);
+  sp_dt_init(&c, &p, 1e-3);
+  double dt = 1e-3;
+  int rejected = 0;
+  while (sp_dt_judge(&c, dt, 4 * sqrt(dt / 1e-3)) == SP_DT_REJECT && rejected < 10) {
+    const double err = 4 * sqrt(dt / 1e-3);
+    if (rejected == 0)
+      CHECK_NEAR(c.dt_next, dt * SP_DT_SAFETY * pow(err, -1.0 / 3), 1e-18);
+    else /* the observed exponent 1/2 */
+      CHECK_NEAR(c.dt_next, dt * fmax(SP_DT_CUT_MIN, SP_DT_SAFETY * pow(err, -2.0)), 1e-18);
+    dt = c.dt_next;
+    ++rejected;
+  }
+  CHECK(rejected <= 3, "%d rejections of an estimate ~ dt^(1/2)", rejected);
+  /* an estimate that falls as fast as dt^4 (> k): the cut keeps k = 3 */
+  sp_dt_init(&c, &p, 1e-3);
+  CHECK(sp_dt_judge(&c, 1e-3, 1e3) == SP_DT_REJECT, "err 1e3 accepted");
+  dt = c.dt_next; /* the largest cut, 2e-4: err 1e3 x 0.2^4 = 1.6 */
+  const double err_fast = 1e3 * pow(dt / 1e-3, 4);
+  CHECK(sp_dt_judge(&c, dt, err_fast) == SP_DT_REJECT, "err %g accepted", err_fast);
+  CHECK_NEAR(c.dt_next, dt * SP_DT_SAFETY * pow(err_fast, -1.0 / 3), 1e-18);
+  /* no decrease: the largest cut */
+  sp_dt_init(&c, &p, 1e-3);
+  CHECK(sp_dt_judge(&c, 1e-3, 2.0) == SP_DT_REJECT, "err 2 accepted");
+  dt = c.dt_next;
+  CHECK(sp_dt_judge(&c, dt, 2.5) == SP_DT_REJECT, "err 2.5 accepted");
+  CHECK_NEAR(c.dt_next, dt * SP_DT_CUT_MIN, 1e-18);
+  /* accepted: the next step's first rejection uses k again */
+  sp_dt_accepted(&c, c.dt_next, 0.5);
+  dt = c.dt_next;
+  CHECK(sp_dt_judge(&c, dt, 4.0) == SP_DT_REJECT, "err 4 accepted");
+  CHECK_NEAR(c.dt_next, dt * SP_DT_SAFETY * pow(4.0, -1.0 / 3), 1e-18);
+}
+
 int main(void) {
   check_judge();
+  check_observed_exponent();
   check_growth();
   check_newton_failure();
   check_fixed();

@@ -87,8 +87,8 @@ static void test_defaults(void) {
   /* the fast path by default (docs/time-stepping.md) */
   CHECK(s->time.control == SP_CONTROL_ADAPTIVE && s->time.scheme == SP_TIME_BDF2,
         "control %d scheme %d", s->time.control, s->time.scheme);
-  CHECK_NEAR(s->time.rtol, 1e-1, 0.0);
-  CHECK_NEAR(s->time.atol, 1e-1, 0.0);
+  CHECK_NEAR(s->time.rtol, 1e-2, 0.0);
+  CHECK_NEAR(s->time.atol, 1e-2, 0.0);
   CHECK_NEAR(s->time.dt_max, 1.0, 0.0);
   CHECK_NEAR(s->output.interval, 0.0, 0.0);
   CHECK_NEAR(s->noise.background, 0.0, 0.0);
@@ -98,6 +98,7 @@ static void test_defaults(void) {
   CHECK(s->solver.linear == SP_LINEAR_MUMPS, "linear %d", s->solver.linear);
   CHECK(s->solver.predictor == SP_PREDICT_LINEAR, "predictor %d", s->solver.predictor);
   CHECK_NEAR(s->solver.jacobian_reuse, 0.1, 0.0);
+  CHECK_NEAR(s->solver.jacobian_carry, 0.35, 0.0);
   CHECK_NEAR(s->solver.newton_rtol, 1e-8, 0.0);
   CHECK_NEAR(s->solver.newton_atol, 1e-10, 0.0);
   CHECK(s->solver.newton_max_its == 12, "newton_max_its %d",
