@@ -177,13 +177,14 @@ class UpdateSmall : public ConditionTest {
                         .getEpetraVector();
     const auto &xp = dynamic_cast<const NOX::Epetra::Vector &>(
                          solver.getPreviousSolutionGroup().getX()).getEpetraVector();
-    double worst = 0;  // (a NaN sticks, and fails)
+    double worst = 0;
+    int nan = 0;  // (a NaN anywhere fails)
     for (int i = 0; i < x.MyLength(); ++i) {
       if (x.Map().GID(i) % 2 != 0) continue;
       const double e = std::fabs(x[i] - xp[i]) / (atol_ + rtol_ * std::fabs(x[i]));
-      if (!(e <= worst)) worst = e;
+      if (std::isnan(e)) nan = 1;
+      else if (e > worst) worst = e;
     }
-    int nan = std::isnan(worst) ? 1 : 0;
     MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, comm_);
     MPI_Allreduce(MPI_IN_PLACE, &nan, 1, MPI_INT, MPI_MAX, comm_);
     return !nan && worst <= 1;
@@ -476,45 +477,43 @@ bool Solver::may_reuse_jacobian() const {
 }
 
 bool Solver::factor_jacobian(std::string &why) {
-  {
-    double t0 = now();
-    const int n = jacobian_matrix->NumMyRows();
-    CsrRows A;
-    A.n_global = n_global_;
-    A.first_row = first_row_;
-    A.n_rows = n;
-    if (rows_in_place_) {
-      int *offsets, *cols;
+  double t0 = now();
+  const int n = jacobian_matrix->NumMyRows();
+  CsrRows A;
+  A.n_global = n_global_;
+  A.first_row = first_row_;
+  A.n_rows = n;
+  if (rows_in_place_) {
+    int *offsets, *cols;
+    double *vals;
+    if (jacobian_matrix->ExtractCrsDataPointers(offsets, cols, vals) != 0)
+      throw std::logic_error("the Jacobian's storage is not contiguous");
+    A.row_ptr = offsets;
+    A.col = cols;
+    A.val = vals;
+    A.matrix = jacobian_matrix.get();
+  } else {
+    for (int i = 0; i < n; ++i) {
+      int len;
       double *vals;
-      if (jacobian_matrix->ExtractCrsDataPointers(offsets, cols, vals) != 0)
-        throw std::logic_error("the Jacobian's storage is not contiguous");
-      A.row_ptr = offsets;
-      A.col = cols;
-      A.val = vals;
-      A.matrix = jacobian_matrix.get();
-    } else {
-      for (int i = 0; i < n; ++i) {
-        int len;
-        double *vals;
-        jacobian_matrix->ExtractMyRowView(i, len, vals);
-        for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = vals[csr_from_[k]];
-      }
-      A.row_ptr = csr_ptr_.data();
-      A.col = csr_col_.data();
-      A.val = csr_val_.data();
+      jacobian_matrix->ExtractMyRowView(i, len, vals);
+      for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = vals[csr_from_[k]];
     }
-    linear_->set_rhs_count(1);
-    bool ok = linear_->factor(A, !pattern_changed_, why);
-    ok = all_agree(comm_.Comm(), ok, why);
-    t_factor += now() - t0;
-    if (!ok) {
-      pattern_changed_ = true;  // start the next factorisation from scratch
-      return false;
-    }
-    pattern_changed_ = false;
-    jacobian_fresh_ = false;
-    ++step_factorisations_;
+    A.row_ptr = csr_ptr_.data();
+    A.col = csr_col_.data();
+    A.val = csr_val_.data();
   }
+  linear_->set_rhs_count(1);
+  bool ok = linear_->factor(A, !pattern_changed_, why);
+  ok = all_agree(comm_.Comm(), ok, why);
+  t_factor += now() - t0;
+  if (!ok) {
+    pattern_changed_ = true;  // start the next factorisation from scratch
+    return false;
+  }
+  pattern_changed_ = false;
+  jacobian_fresh_ = false;
+  ++step_factorisations_;
   return true;
 }
 

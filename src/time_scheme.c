@@ -140,7 +140,8 @@ double sp_scheme_error(sp_scheme_kind kind, const sp_history *h, double dt,
     const double c = state_new[2 * p];
     const double scale = atol + rtol * fmax(fabs(state[2 * p]), fabs(c));
     const double e = factor * fabs(c - scratch[2 * p]) / scale;
-    if (!(e <= err)) err = e; /* NaN sticks */
+    if (isnan(e)) return e; /* rejected */
+    if (e > err) err = e;
   }
   return err;
 }
