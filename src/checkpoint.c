@@ -11,6 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "agree.h"
 #include "build_info.h"
 #include "error.h"
 #include "solver_status.h"
@@ -175,7 +176,6 @@ enum { H_STEP, H_N_MAX, H_MPI_SIZE, H_N_CELLS, H_HIST_N, H_N_ENERGY, H_N_DIVISIO
        HEADER_INTS };
 enum { H_T, H_DT0, H_DT1, HEADER_DOUBLES };
 
-/** Write the whole state into the open file @p f; nonzero on an HDF5 error. */
 /** sp_shape_coef as doubles in /carry/shape. */
 enum { SHAPE_DOUBLES = sizeof(sp_shape_coef) / sizeof(double) };
 _Static_assert(sizeof(sp_shape_coef) == SHAPE_DOUBLES * sizeof(double),
@@ -202,6 +202,7 @@ static int put_carry(hid_t f, const sp_run *run) {
   return bad;
 }
 
+/** Write the whole state into the open file @p f; nonzero on an HDF5 error. */
 static int write_state(hid_t f, const sp_run *run) {
   const sp_layout *ly = run->layout;
   const size_t n_pairs = (size_t)ly->n_pairs, nc = (size_t)ly->n_cells;
@@ -765,25 +766,29 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
 
 int sp_checkpoint_restore_carry(const sp_checkpoint ck, sp_run *run) {
   if (H5LTpath_valid(ck->file, "/carry/header", 1) <= 0) return SP_OK; /* an older file */
-  int header[3];
-  SP_CALL(get_array(ck, "/carry/header", H5T_NATIVE_INT, header, 3));
+  int header[3] = {0, 0, 0};
+  int rc = get_array(ck, "/carry/header", H5T_NATIVE_INT, header, 3);
   const int carry = header[0], n_shape = header[1];
-  SP_CHECK((carry == 0 || carry == 1) && n_shape >= 0 &&
-               (n_shape == 0 || n_shape == run->layout->n_cells),
-           SP_ERR_INPUT, "checkpoint '%s': /carry damaged", ck->path);
-  if (!carry) return SP_OK;
+  if (rc == SP_OK && !((carry == 0 || carry == 1) && n_shape >= 0 &&
+                       (n_shape == 0 || n_shape == run->layout->n_cells)))
+    rc = sp_error_set(SP_ERR_INPUT, "checkpoint '%s': /carry damaged", ck->path);
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
-  double dt = 0;
-  double *x = malloc(sizeof(double) * n_values + 1);
-  sp_shape_coef *shape = n_shape ? malloc(sizeof *shape * (size_t)n_shape) : NULL;
-  int rc = x && (shape || !n_shape) ? SP_OK : sp_error_set(SP_ERR_MEMORY, "out of memory");
-  if (rc == SP_OK) rc = get_array(ck, "/carry/dt", H5T_NATIVE_DOUBLE, &dt, 1);
-  if (rc == SP_OK) rc = get_array(ck, "/carry/x", H5T_NATIVE_DOUBLE, x, n_values);
-  if (rc == SP_OK && n_shape)
-    rc = get_array(ck, "/carry/shape", H5T_NATIVE_DOUBLE, shape, SHAPE_DOUBLES * (size_t)n_shape);
-  if (rc == SP_OK && !(dt > 0))
-    rc = sp_error_set(SP_ERR_INPUT, "checkpoint '%s': /carry/dt damaged", ck->path);
-  if (rc == SP_OK) {
+  double dt = 0, *x = NULL;
+  sp_shape_coef *shape = NULL;
+  if (rc == SP_OK && carry) {
+    x = malloc(sizeof(double) * n_values + 1);
+    shape = n_shape ? malloc(sizeof *shape * (size_t)n_shape) : NULL;
+    if (!x || (n_shape && !shape)) rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
+    if (rc == SP_OK) rc = get_array(ck, "/carry/dt", H5T_NATIVE_DOUBLE, &dt, 1);
+    if (rc == SP_OK) rc = get_array(ck, "/carry/x", H5T_NATIVE_DOUBLE, x, n_values);
+    if (rc == SP_OK && n_shape)
+      rc = get_array(ck, "/carry/shape", H5T_NATIVE_DOUBLE, shape,
+                     SHAPE_DOUBLES * (size_t)n_shape);
+    if (rc == SP_OK && !(dt > 0))
+      rc = sp_error_set(SP_ERR_INPUT, "checkpoint '%s': /carry/dt damaged", ck->path);
+  }
+  rc = sp_agree(run->agree_comm, rc); /* the rebuild is collective */
+  if (rc == SP_OK && carry) {
     const sp_step_data data = {.dt = dt, .model = run->model, .state_old = x, .shape = shape,
                                .shape_implicit = header[2]};
     const int status = sp_solver_carry_restore(run->solver, &data, x);
