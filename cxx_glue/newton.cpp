@@ -178,16 +178,13 @@ class UpdateSmall : public ConditionTest {
     const auto &xp = dynamic_cast<const NOX::Epetra::Vector &>(
                          solver.getPreviousSolutionGroup().getX()).getEpetraVector();
     double worst = 0;
-    int nan = 0;  // (a NaN anywhere fails)
     for (int i = 0; i < x.MyLength(); ++i) {
       if (x.Map().GID(i) % 2 != 0) continue;
       const double e = std::fabs(x[i] - xp[i]) / (atol_ + rtol_ * std::fabs(x[i]));
-      if (std::isnan(e)) nan = 1;
-      else if (e > worst) worst = e;
+      worst = std::isnan(e) ? INFINITY : std::max(worst, e);  // (a NaN anywhere fails)
     }
     MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPI_DOUBLE, MPI_MAX, comm_);
-    MPI_Allreduce(MPI_IN_PLACE, &nan, 1, MPI_INT, MPI_MAX, comm_);
-    return !nan && worst <= 1;
+    return worst <= 1;
   }
 
  private:
@@ -395,7 +392,7 @@ void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
   assembly_->jacobian(shape_.data_at(d, *assembly_, full_.data()), full_.data(),
                       options_.jacobian, *jacobian_matrix);
   jacobian_fresh_ = true;
-  if (options_.jacobian_reuse > 0 && options_.jacobian_carry > 0) {
+  if (carries()) {
     jac_x_ = full_;
     jac_dt_ = d.dt;
     jac_shape_implicit_ = d.shape_implicit;
@@ -442,14 +439,12 @@ bool Solver::carry_point(double &dt, const std::vector<double> *&x,
   x = &jac_x_;
   shape = &jac_shape_;
   shape_implicit = jac_shape_implicit_;
-  return options_.jacobian_reuse > 0 && options_.jacobian_carry > 0 && last_converged_ &&
-         !pattern_changed_ && !jacobian_fresh_ && !jac_x_.empty();
+  return factor_carryable() && !jac_x_.empty();
 }
 
 void Solver::carry_restore(const sp_step_data &d, const double *x) {
   require_problem();
-  if (!(options_.jacobian_reuse > 0 && options_.jacobian_carry > 0))
-    return;  // (a continued run with the carry switched off: nothing to carry)
+  if (!carries()) return;  // (a continued run with the carry switched off: nothing to carry)
   const Epetra_Map &map = assembly_->map();
   Epetra_Vector xv(map);
   for (int i = 0; i < map.NumMyElements(); ++i) xv[i] = x[map.GID(i)];
@@ -531,6 +526,9 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string 
 
 int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   require_problem();
+  if (!(d.update_rtol >= 0 && d.update_atol >= 0) ||
+      (d.update_rtol > 0 && !(d.update_atol > 0)))
+    throw input_error("sp_step_data: expected update_atol > 0 with update_rtol > 0, both >= 0");
   report = sp_step_report{};
   t_assembly = t_factor = t_solve = 0;
   step_factorisations_ = 0;
@@ -545,8 +543,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   // Carry the last step's factorisation: same layout, the last step
   // converged, no low-rank term (its Woodbury factors belong to the last
   // step's shape coefficients); the first iteration's contraction decides.
-  carried_ = options_.jacobian_reuse > 0 && options_.jacobian_carry > 0 && last_converged_ &&
-             !pattern_changed_ && !jacobian_fresh_ && linear_->term().empty();
+  carried_ = factor_carryable() && linear_->term().empty();
   last_converged_ = false;
   auto iface = Teuchos::rcp(new StepInterface(*this, d));
   auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *iface));
@@ -581,9 +578,6 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   auto tolerance = Teuchos::rcp(new Combo(Combo::OR));
   tolerance->addStatusTest(Teuchos::rcp(new NormF(options_.newton_atol, NormF::Unscaled)));
   tolerance->addStatusTest(Teuchos::rcp(new NormF(*group, options_.newton_rtol, NormF::Unscaled)));
-  if (!(d.update_rtol >= 0 && d.update_atol >= 0) ||
-      (d.update_rtol > 0 && !(d.update_atol > 0)))
-    throw input_error("sp_step_data: expected update_atol > 0 with update_rtol > 0, both >= 0");
   if (d.update_rtol > 0 || d.update_atol > 0)
     tolerance->addStatusTest(
         Teuchos::rcp(new UpdateSmall(comm_.Comm(), d.update_rtol, d.update_atol)));

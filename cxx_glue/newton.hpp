@@ -108,6 +108,13 @@ class Solver {
   std::vector<sp_shape_coef> jac_shape_;
   // Factor jacobian_matrix (solve_linear's first part); false: why says.
   bool factor_jacobian(std::string &why);
+  // Factorisations may carry across steps (jacobian_carry, with modified
+  // Newton), and the current one may: the last step converged on it, on
+  // this layout, and no Jacobian was filled since.
+  bool carries() const { return options_.jacobian_reuse > 0 && options_.jacobian_carry > 0; }
+  bool factor_carryable() const {
+    return carries() && last_converged_ && !pattern_changed_ && !jacobian_fresh_;
+  }
   std::vector<double> step_norms_;  // ||F|| at the guess and after each iteration
   std::vector<double> full_;     // scratch: the replicated state
   ImplicitShape shape_;          // the current step's implicit shape term
