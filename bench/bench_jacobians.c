@@ -90,8 +90,8 @@ static void time_kinds(int n_cells, int scale) {
   const sp_solver s = run.solver;
   const int n = 2 * run.layout->n_pairs;
   const double *state = run.state;
-  memcpy(run.state_old, state, n * sizeof(double));
-  sp_step_data data = {.dt = 1e-5, .model = run.model, .state_old = run.state_old};
+  memcpy(run.buf.state_old, state, n * sizeof(double));
+  sp_step_data data = {.dt = 1e-5, .model = run.opt.model, .state_old = run.buf.state_old};
   /* hand first: the ratios are to it. ad at 16 cells is DFad already. */
   int kinds[4] = {SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_AD_DFAD, SP_SOLVER_JAC_FD};
   int base = n_cells == 1 ? 20 : n_cells == 4 ? 6 : 2;
@@ -131,8 +131,8 @@ static void newton_kinds(void) {
     double t_asm = 0, t_fac = 0, t_tot = 0;
     int its = 0;
     for (int step = 0; step < steps; ++step) {
-      memcpy(run.state_old, run.state, n * sizeof(double));
-      sp_step_data data = {.dt = 1e-5, .model = run.model, .state_old = run.state_old};
+      memcpy(run.buf.state_old, run.state, n * sizeof(double));
+      sp_step_data data = {.dt = 1e-5, .model = run.opt.model, .state_old = run.buf.state_old};
       sp_step_report rep;
       int rc = sp_solver_step(run.solver, &data, run.state, &rep);
       if (rc != 0) {

@@ -23,6 +23,7 @@
 #include "mesh.h"
 #include "q1.h"
 #include "softpack_solver.h"
+#include "resize.h"
 #include "stepper.h"
 
 #define N_CELLS 3

@@ -15,11 +15,11 @@
 #include <mpi.h>
 #include <stdint.h>
 
+#include "softpack_newton.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-#define SP_MAX_NEWTON_HISTORY 64
 
 /**
  * What every entry point returns: 0, Newton's failure to converge
@@ -183,15 +183,6 @@ typedef struct {
   double update_rtol, update_atol;
 } sp_step_data;
 
-/** Why a Newton solve failed (sp_step_report.failure). */
-typedef enum {
-  SP_NEWTON_CONVERGED = 0,
-  SP_NEWTON_MAX_ITERATIONS, /**< solver.newton_max_its reached */
-  SP_NEWTON_DIVERGED,       /**< |F| above solver.newton_divergence x the first */
-  SP_NEWTON_NOT_FINITE,     /**< a residual norm was not finite */
-  SP_NEWTON_LINEAR_FAILED,  /**< a linear solve failed (reason says how) */
-  SP_NEWTON_OTHER_FAILURE   /**< NOX stopped for another reason */
-} sp_newton_failure;
 
 /** What a step did. */
 typedef struct {

@@ -7,13 +7,12 @@
 #include <string.h>
 
 #include "agree.h"
-#include "dt_control.h"
 #include "error.h"
 #include "run_setup.h"
 #include "scene.h"
 #include "softpack_solver.h"
 #include "solver_status.h"
-#include "stepper.h"
+#include "step.h"
 
 /** What the command holds: the scene and the run set up from it
  *  (run_setup.h), so the Jacobians are checked on exactly the layout, node
@@ -41,15 +40,15 @@ static int compare(checkjac *c, const sp_step_data *data, int a, int b, double *
 static int check_state(checkjac *c, const char *what, double t, double *worst_hand_ad) {
   const sp_run *run = &c->run;
   /* At the start of a step: state_old = state, Jacobian at the state. */
-  memcpy(run->state_old, run->state, 2 * (size_t)run->layout->n_pairs * sizeof(double));
+  memcpy(run->buf.state_old, run->state, 2 * (size_t)run->layout->n_pairs * sizeof(double));
   static const char *rows[] = {"all terms", "lambda = 0", "lambda_b = 0",
                                "lambda = lambda_b = 0"};
   if (run->rank == 0)
     printf("\n%s (t = %.6g):\n  %-24s %12s %12s %12s\n", what, t, "terms", "hand vs ad",
            "ad vs fd", "hand vs fd");
   for (int r = 0; r < 4; ++r) {
-    sp_step_data data = {.dt = c->scene->time.dt, .model = run->model,
-                         .state_old = run->state_old, .source = NULL, .shape = NULL};
+    sp_step_data data = {.dt = run->opt.time.dt.dt, .model = run->opt.model,
+                         .state_old = run->buf.state_old, .source = NULL, .shape = NULL};
     if (r == 1 || r == 3) data.model.lambda = 0.0;
     if (r == 2 || r == 3) data.model.lambda_b = 0.0;
     double hand_ad, ad_fd, hand_fd;
@@ -63,38 +62,25 @@ static int check_state(checkjac *c, const char *what, double t, double *worst_ha
   return SP_OK;
 }
 
-/** K backward-Euler steps of the run's state under the run's time-step
- *  controller (dt_control.h: the scene's time.control; no error estimate
- *  here, so an adaptive controller holds its first dt), never accepting a
- *  failed Newton solve. No source, shape term, division or support change:
- *  the layout stays the set-up's. */
-static int take_steps(checkjac *c, int steps, double *t, double *dt_last, int *retries) {
+/** K steps of the run's state, taken as a run takes them (step.h: the
+ *  scene's scheme, controller, source and shape term; a failed attempt is
+ *  retried smaller, never accepted), without the events after a step
+ *  (divisions, support changes): the layout stays the set-up's. */
+static int take_steps(checkjac *c, int steps, double *dt_last, int *retries) {
   sp_run *run = &c->run;
-  const size_t n_values = 2 * (size_t)run->layout->n_pairs;
-  sp_dt_params p;
-  sp_dt_params_from_scene(c->scene, &p);
-  sp_dt_control dtc;
-  sp_dt_init(&dtc, &p, c->scene->time.dt);
-  for (int step = 0; step < steps;) {
-    const double dt = sp_dt_propose(&dtc, *t, INFINITY, NULL);
-    memcpy(run->state_old, run->state, n_values * sizeof(double));
-    sp_step_data data = {.dt = dt, .model = run->model, .state_old = run->state_old,
-                         .source = NULL, .shape = NULL};
-    sp_step_report report;
-    int rc = sp_solver_step(run->solver, &data, run->state, &report);
-    if (rc > SP_SOLVER_NOT_CONVERGED) return sp_solver_failed(run->solver, rc, "step %d", step + 1);
-    if (rc == 1) {
-      memcpy(run->state, run->state_old, n_values * sizeof(double));
-      ++*retries;
-      if (sp_dt_newton_failed(&dtc, dt))
-        return sp_error_set(SP_ERR_SOLVER, "Newton failed on step %d at t = %.6g: %s",
-                            step + 1, *t, report.reason);
+  sp_step_begin(run);
+  while (run->step < steps) {
+    sp_step_attempt a;
+    SP_CALL(sp_step_try(run, &a));
+    if (a.verdict == SP_STEP_ACCEPTED) {
+      SP_CALL(sp_step_complete(run, &a));
+      *dt_last = a.dt;
       continue;
     }
-    sp_dt_accepted(&dtc, dt, -1.0);
-    *dt_last = dt;
-    *t += dt;
-    ++step;
+    ++*retries;
+    if (a.give_up)
+      return sp_error_set(SP_ERR_SOLVER, "step %d at t = %.6g failed %d attempts: %s",
+                          run->step + 1, run->t, run->dtc.failures, a.why);
   }
   return SP_OK;
 }
@@ -150,7 +136,8 @@ int sp_check_jacobian_command(int argc, char **argv) {
   if (rc == SP_OK && steps > 0) {
     double dt_last = 0.0;
     int retries = 0;
-    rc = sp_agree(agree, take_steps(&c, steps, &t, &dt_last, &retries));
+    rc = sp_agree(agree, take_steps(&c, steps, &dt_last, &retries));
+    t = c.run.t;
     char what[160];
     snprintf(what, sizeof what, "after %d step%s (last dt %.3g, %d failed attempt%s retried)",
              steps, steps == 1 ? "" : "s", dt_last, retries, retries == 1 ? "" : "s");

@@ -14,6 +14,7 @@
 #include "agree.h"
 #include "build_info.h"
 #include "error.h"
+#include "resize.h"
 #include "solver_status.h"
 
 #define SP_CHECKPOINT_FORMAT "softpack checkpoint"
@@ -207,17 +208,17 @@ static int write_state(hid_t f, const sp_run *run) {
   const sp_layout *ly = run->layout;
   const size_t n_pairs = (size_t)ly->n_pairs, nc = (size_t)ly->n_cells;
   int bad = 0;
-  char *overrides = join_overrides(run->n_set, run->set);
+  char *overrides = join_overrides(run->scene_text.n_set, run->scene_text.set);
   if (!overrides) return 1;
-  char *text = malloc(run->scene_len + 1);
+  char *text = malloc(run->scene_text.len + 1);
   if (!text) {
     free(overrides);
     return 1;
   }
-  if (run->scene_len) memcpy(text, run->scene_text, run->scene_len);
-  text[run->scene_len] = '\0';
+  if (run->scene_text.len) memcpy(text, run->scene_text.text, run->scene_text.len);
+  text[run->scene_text.len] = '\0';
   char hash[32];
-  snprintf(hash, sizeof hash, "%016llx", scene_hash(text, run->scene_len, overrides));
+  snprintf(hash, sizeof hash, "%016llx", scene_hash(text, run->scene_text.len, overrides));
   const int version = SP_CHECKPOINT_VERSION;
   const unsigned long long mh = mesh_hash(run->mesh);
   char mesh_h[32];
@@ -238,9 +239,9 @@ static int write_state(hid_t f, const sp_run *run) {
   for (const char *g = "/layout\0/history\0/cells\0/controller\0/summary\0/output\0"; *g;
        g += strlen(g) + 1)
     bad |= make_group(f, g);
-  const int n_fields_now = run->output ? sp_output_fields_list(run->output, &(const sp_output_field *){NULL}) : 0;
+  const int n_fields_now = run->mon.output ? sp_output_fields_list(run->mon.output, &(const sp_output_field *){NULL}) : 0;
   const int header[HEADER_INTS] = {run->step, run->n_max, run->n_ranks, ly->n_cells,
-                                   run->hist.n, run->n_energy, run->n_divisions, n_fields_now};
+                                   run->hist.n, run->mon.n_energy, run->mon.n_divisions, n_fields_now};
   const double header_t[HEADER_DOUBLES] = {run->t, run->hist.dt[0], run->hist.dt[1]};
   bad |= put_array(f, "/header", H5T_NATIVE_INT, header, HEADER_INTS);
   bad |= put_array(f, "/header_t", H5T_NATIVE_DOUBLE, header_t, HEADER_DOUBLES);
@@ -255,33 +256,33 @@ static int write_state(hid_t f, const sp_run *run) {
   int *icol = malloc(sizeof(int) * (nc + 1));
   if (!col || !icol) bad = 1;
   else {
-    for (size_t k = 0; k < nc; ++k) col[k] = run->birth[k].birth_time;
+    for (size_t k = 0; k < nc; ++k) col[k] = run->cells.birth[k].birth_time;
     bad |= put_array(f, "/cells/birth_time", H5T_NATIVE_DOUBLE, col, nc);
-    for (size_t k = 0; k < nc; ++k) col[k] = run->birth[k].birth_mass;
+    for (size_t k = 0; k < nc; ++k) col[k] = run->cells.birth[k].birth_mass;
     bad |= put_array(f, "/cells/birth_mass", H5T_NATIVE_DOUBLE, col, nc);
     for (size_t k = 0; k < nc; ++k) {
-      col[2 * k] = run->birth[k].Iref[0];
-      col[2 * k + 1] = run->birth[k].Iref[1];
+      col[2 * k] = run->cells.birth[k].Iref[0];
+      col[2 * k + 1] = run->cells.birth[k].Iref[1];
     }
     bad |= put_array(f, "/cells/Iref", H5T_NATIVE_DOUBLE, col, 2 * nc);
-    for (size_t k = 0; k < nc; ++k) icol[k] = run->birth[k].generation;
+    for (size_t k = 0; k < nc; ++k) icol[k] = run->cells.birth[k].generation;
     bad |= put_array(f, "/cells/generation", H5T_NATIVE_INT, icol, nc);
   }
   free(col);
   free(icol);
-  bad |= put_array(f, "/cells/source_on", H5T_NATIVE_INT, run->source_on, nc);
-  bad |= put_array(f, "/cells/division_skipped", H5T_NATIVE_INT, run->division_skipped, nc);
-  bad |= put_array(f, "/cells/divided_now", H5T_NATIVE_UCHAR, run->divided_now, nc);
+  bad |= put_array(f, "/cells/source_on", H5T_NATIVE_INT, run->cells.source_on, nc);
+  bad |= put_array(f, "/cells/division_skipped", H5T_NATIVE_INT, run->cells.division_skipped, nc);
+  bad |= put_array(f, "/cells/divided_now", H5T_NATIVE_UCHAR, run->cells.divided_now, nc);
   bad |= put_members(f, "/controller", &run->dtc, controller_members, N_OF(controller_members));
-  bad |= put_members(f, "/summary", run->sum, summary_members, N_OF(summary_members));
-  bad |= put_array(f, "/output/energy_t", H5T_NATIVE_DOUBLE, run->energy_t, run->n_energy);
-  bad |= put_array(f, "/output/energy_total", H5T_NATIVE_DOUBLE, run->energy_total,
-                   run->n_energy);
-  bad |= put_array(f, "/output/division_t", H5T_NATIVE_DOUBLE, run->division_t,
-                   run->n_divisions);
+  bad |= put_members(f, "/summary", run->mon.sum, summary_members, N_OF(summary_members));
+  bad |= put_array(f, "/output/energy_t", H5T_NATIVE_DOUBLE, run->mon.energy_t, run->mon.n_energy);
+  bad |= put_array(f, "/output/energy_total", H5T_NATIVE_DOUBLE, run->mon.energy_total,
+                   run->mon.n_energy);
+  bad |= put_array(f, "/output/division_t", H5T_NATIVE_DOUBLE, run->mon.division_t,
+                   run->mon.n_divisions);
   bad |= put_carry(f, run);
   const sp_output_field *fields = NULL;
-  const int n_fields = run->output ? sp_output_fields_list(run->output, &fields) : 0;
+  const int n_fields = run->mon.output ? sp_output_fields_list(run->mon.output, &fields) : 0;
   if (n_fields > 0) {
     int *steps = malloc(sizeof(int) * n_fields), *pvtu = malloc(sizeof(int) * n_fields);
     double *ts = malloc(sizeof(double) * n_fields);
@@ -375,7 +376,7 @@ int sp_checkpoint_write(const sp_run *run, const char *dir, char *path_out, size
   if (path_out) snprintf(path_out, size, "%s", path);
   long *steps;
   const int n = list_checkpoints(dir, &steps);
-  for (int i = run->scene->output.checkpoint_keep; i < n; ++i) {
+  for (int i = run->opt.output.checkpoint_keep; i < n; ++i) {
     char old[4096];
     checkpoint_path(dir, steps[i], old, sizeof old);
     remove(old);
@@ -593,15 +594,6 @@ static int get_array(const sp_checkpoint ck, const char *name, hid_t type, void 
 }
 
 
-/** Grow a per-cell array to @p n entries of @p elem bytes (zeroed). */
-static int cells_array(void **p, size_t elem, int n) {
-  void *q = realloc(*p, elem * (size_t)(n > 0 ? n : 1));
-  SP_CHECK(q, SP_ERR_MEMORY, "out of memory for %d cells", n);
-  memset(q, 0, elem * (size_t)n);
-  *p = q;
-  return SP_OK;
-}
-
 /** The layout and state of the checkpoint (checked against the mesh). */
 static int read_layout(const sp_checkpoint ck, const sp_mesh *mesh, sp_layout **layout,
                        double **state) {
@@ -698,18 +690,18 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
   sp_layout *layout = NULL;
   double *state = NULL;
   SP_CALL(read_layout(ck, run->mesh, &layout, &state));
-  sp_layout_destroy(&run->layout);
-  free(run->state);
-  run->layout = layout;
-  run->state = state;
-  sp_history_free(&run->hist);
+  /* the one layout change (resize.h): the registry sized, new entries
+   * zeroed (all of them: emptied first), the history reset (read below),
+   * the solver given the layout */
+  const int rc_empty = sp_registry_resize(&run->cells, 0);
+  if (rc_empty != SP_OK) {
+    sp_layout_destroy(&layout);
+    free(state);
+    return rc_empty;
+  }
+  SP_CALL(sp_run_resize(run, layout, state, SP_HISTORY_RESET));
   const int nc = layout->n_cells;
   const size_t n_values = 2 * (size_t)layout->n_pairs;
-  SP_CALL(cells_array((void **)&run->obs, sizeof *run->obs, nc));
-  SP_CALL(cells_array((void **)&run->birth, sizeof *run->birth, nc));
-  SP_CALL(cells_array((void **)&run->source_on, sizeof *run->source_on, nc));
-  SP_CALL(cells_array((void **)&run->division_skipped, sizeof(int), nc));
-  SP_CALL(cells_array((void **)&run->divided_now, 1, nc));
   if (as_initial) return SP_OK; /* the caller makes the registry of a new run */
   /* the history */
   sp_history *h = &run->hist;
@@ -728,26 +720,26 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
   int *icol = malloc(sizeof(int) * ((size_t)nc + 1));
   int rc = col && icol ? SP_OK : sp_error_set(SP_ERR_MEMORY, "out of memory");
   if (rc == SP_OK) rc = get_array(ck, "/cells/birth_time", H5T_NATIVE_DOUBLE, col, nc);
-  for (int k = 0; rc == SP_OK && k < nc; ++k) run->birth[k].birth_time = col[k];
+  for (int k = 0; rc == SP_OK && k < nc; ++k) run->cells.birth[k].birth_time = col[k];
   if (rc == SP_OK) rc = get_array(ck, "/cells/birth_mass", H5T_NATIVE_DOUBLE, col, nc);
-  for (int k = 0; rc == SP_OK && k < nc; ++k) run->birth[k].birth_mass = col[k];
+  for (int k = 0; rc == SP_OK && k < nc; ++k) run->cells.birth[k].birth_mass = col[k];
   if (rc == SP_OK) rc = get_array(ck, "/cells/Iref", H5T_NATIVE_DOUBLE, col, 2 * (size_t)nc);
   for (int k = 0; rc == SP_OK && k < nc; ++k) {
-    run->birth[k].Iref[0] = col[2 * k];
-    run->birth[k].Iref[1] = col[2 * k + 1];
+    run->cells.birth[k].Iref[0] = col[2 * k];
+    run->cells.birth[k].Iref[1] = col[2 * k + 1];
   }
   if (rc == SP_OK) rc = get_array(ck, "/cells/generation", H5T_NATIVE_INT, icol, nc);
-  for (int k = 0; rc == SP_OK && k < nc; ++k) run->birth[k].generation = icol[k];
+  for (int k = 0; rc == SP_OK && k < nc; ++k) run->cells.birth[k].generation = icol[k];
   free(col);
   free(icol);
   SP_CALL(rc);
-  SP_CALL(get_array(ck, "/cells/source_on", H5T_NATIVE_INT, run->source_on, nc));
-  SP_CALL(get_array(ck, "/cells/division_skipped", H5T_NATIVE_INT, run->division_skipped, nc));
-  SP_CALL(get_array(ck, "/cells/divided_now", H5T_NATIVE_UCHAR, run->divided_now, nc));
+  SP_CALL(get_array(ck, "/cells/source_on", H5T_NATIVE_INT, run->cells.source_on, nc));
+  SP_CALL(get_array(ck, "/cells/division_skipped", H5T_NATIVE_INT, run->cells.division_skipped, nc));
+  SP_CALL(get_array(ck, "/cells/divided_now", H5T_NATIVE_UCHAR, run->cells.divided_now, nc));
   /* the controller, the counters, step and time */
   SP_CALL(get_members(ck->file, ck->path, "/controller", &run->dtc, controller_members,
                       N_OF(controller_members)));
-  SP_CALL(get_members(ck->file, ck->path, "/summary", run->sum, summary_members,
+  SP_CALL(get_members(ck->file, ck->path, "/summary", run->mon.sum, summary_members,
                       N_OF(summary_members)));
   run->n_max = ck->header[H_N_MAX];
   run->step = ck->step;
@@ -756,11 +748,11 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
   const int n_energy = ck->header[H_N_ENERGY], n_div = ck->header[H_N_DIVISIONS];
   SP_CHECK(n_energy >= 0 && n_div >= 0, SP_ERR_INPUT, "checkpoint '%s': /output damaged",
            ck->path);
-  SP_CALL(read_doubles(ck, "/output/energy_t", &run->energy_t, n_energy));
-  SP_CALL(read_doubles(ck, "/output/energy_total", &run->energy_total, n_energy));
-  run->n_energy = run->cap_energy = n_energy;
-  SP_CALL(read_doubles(ck, "/output/division_t", &run->division_t, n_div));
-  run->n_divisions = n_div;
+  SP_CALL(read_doubles(ck, "/output/energy_t", &run->mon.energy_t, n_energy));
+  SP_CALL(read_doubles(ck, "/output/energy_total", &run->mon.energy_total, n_energy));
+  run->mon.n_energy = run->mon.cap_energy = n_energy;
+  SP_CALL(read_doubles(ck, "/output/division_t", &run->mon.division_t, n_div));
+  run->mon.n_divisions = n_div;
   return read_fields_list(ck, fields, n_fields);
 }
 
@@ -789,7 +781,7 @@ int sp_checkpoint_restore_carry(const sp_checkpoint ck, sp_run *run) {
   }
   rc = sp_agree(run->agree_comm, rc); /* the rebuild is collective */
   if (rc == SP_OK && carry) {
-    const sp_step_data data = {.dt = dt, .model = run->model, .state_old = x, .shape = shape,
+    const sp_step_data data = {.dt = dt, .model = run->opt.model, .state_old = x, .shape = shape,
                                .shape_implicit = header[2]};
     const int status = sp_solver_carry_restore(run->solver, &data, x);
     if (status != SP_SOLVER_OK)

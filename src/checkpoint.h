@@ -20,7 +20,7 @@
  *                     source_on, division_skipped, divided_now
  *   /controller       the time-step controller's state (dt_control.h), one
  *                     attribute per member; its parameters come from the scene
- *   /summary          the run's counters (stepper.h: sp_run_summary)
+ *   /summary          the run's counters (run_types.h: sp_run_summary)
  *   /output           energy_t, energy_total (energy.png), division_t,
  *                     field_step, field_t, field_pvtu (fields.pvd)
  *   /carry            header (carry, n_shape, shape_implicit); with carry = 1
@@ -48,7 +48,8 @@ extern "C" {
 /** The checkpoint format this build writes and reads. */
 #define SP_CHECKPOINT_VERSION 1
 
-typedef sp_checkpoint_handle sp_checkpoint;
+/** An open checkpoint (sp_checkpoint_open). */
+typedef struct sp_checkpoint_s *sp_checkpoint;
 
 /** @brief Write the run's state to DIR/checkpoint_<step>.h5 (rank 0 only;
  *         temporary name, then rename) and delete all but the newest
@@ -85,9 +86,10 @@ void sp_checkpoint_cells(const sp_checkpoint ck, int *n_cells, int *n_max);
 /**
  * @brief Put the checkpoint's state into @p run, set up from the same
  *        scene (mesh, solver, registry arrays of the initial cells): the
- *        layout and fields, history, registry, controller state, step, t,
- *        counters and the energy history; the caller hands the layout to
- *        the solver. @p fields / @p n_fields: the fields.pvd list (free()).
+ *        layout and fields (through the one layout change, resize.h: the
+ *        solver gets the layout; collective), history, registry,
+ *        controller state, step, t, counters and the energy history.
+ *        @p fields / @p n_fields: the fields.pvd list (free()).
  *        @p as_initial: the fields and cells only, as a new run's initial
  *        state at t = 0 (every cell born then, with its mass now).
  */

@@ -119,3 +119,7 @@ void sp_dt_restart(sp_dt_control *c, double dt_first) {
   c->rejected_last = 0;
   c->rejected_dt = c->rejected_err = 0;
 }
+
+void sp_dt_land(sp_dt_control *c, double dt) { c->dt_next = fmax(dt, c->p.dt_min); }
+
+void sp_dt_resume(sp_dt_control *c, const sp_dt_params *p) { c->p = *p; }

@@ -130,6 +130,15 @@ int sp_dt_give_up(const sp_dt_control *c);
  *         the next dt. */
 void sp_dt_accepted(sp_dt_control *c, double dt, double err);
 
+/** @brief A step of @p dt_full overshot an event inside it (a cell's mass
+ *         passed its division mass): redo it with @p dt, at least dt_min
+ *         (not a failure: nothing counts against the step). */
+void sp_dt_land(sp_dt_control *c, double dt);
+
+/** @brief A controller restored from a checkpoint takes the continued
+ *         run's parameters (time.* may differ: t_end, max_steps). */
+void sp_dt_resume(sp_dt_control *c, const sp_dt_params *p);
+
 /** @brief A cell divided: fixed restarts algorithm 2's ramp; adaptive starts
  *         again without an error history from @p dt_first, at most
  *         SP_DT_RESTART_FRACTION of the last accepted step. */

@@ -29,7 +29,6 @@
 #include "scene.h"
 #include "sp_revision.h" /* SP_GIT_REVISION, generated at build time */
 #include "run.h"
-#include "stepper.h"
 
 static void usage(FILE *to) {
   fprintf(to,
@@ -87,7 +86,7 @@ static void print_summary(const sp_run_summary *sum, const char *out_dir) {
 }
 
 /** The progress line on a terminal: redrawn in place at most
- *  SP_PROGRESS_HZ times a second (failure lines go above it, stepper.c). */
+ *  SP_PROGRESS_HZ times a second (failure lines go above it, monitor.c). */
 #define SP_PROGRESS_HZ 4
 typedef struct {
   int rank, drawn;

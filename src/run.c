@@ -7,6 +7,7 @@
 #include "checkpoint.h"
 #include "initial.h"
 #include "scene.h"
+#include "stepper.h"
 
 static int run_loaded(int rc, sp_scene *scene, const sp_run_start *start, const char *out_dir,
                       MPI_Comm comm, sp_step_callback on_step, void *user,

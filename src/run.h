@@ -26,7 +26,7 @@
  * and the failing rank's message). The ranks agree over a duplicate of
  * @p comm with MPI_ERRORS_RETURN; @p comm's own error handler is left as
  * it is (with MPI's default, an MPI error inside the solver aborts). The callback (may be NULL) sees every accepted step
- * (stepper.h: sp_step_info, the cells' observables included) and stops the
+ * (run_types.h: sp_step_info, the cells' observables included) and stops the
  * run by returning non-zero (summary->stopped = 1, the state written as at
  * the end).
  */
@@ -37,7 +37,7 @@
 #include <stddef.h>
 
 #include "error.h"
-#include "stepper.h"
+#include "run_types.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -74,6 +74,14 @@ typedef struct {
 int sp_run_file_restart(const char *path, int n_set, const char *const *set,
                         const char *out_dir, const sp_restart *restart, MPI_Comm comm,
                         sp_step_callback on_step, void *user, sp_run_summary *summary);
+
+/**
+ * @brief Ask the run in progress (this process's) to write a checkpoint at
+ *        the end of the step in progress and stop there (summary.stopped =
+ *        SP_STOPPED_SIGNAL). Async-signal-safe: `softpack run` calls it on
+ *        SIGTERM, SIGINT and SIGUSR1. One rank asking stops every rank.
+ */
+void sp_run_request_stop(void);
 
 #ifdef __cplusplus
 }

@@ -1,88 +1,109 @@
 /**
  * @file run_state.h
- * @brief The run's state in one object: everything a step depends on, with
- *        one lifecycle (set up and freed by run_setup.h, stepped by the
- *        stepper, saved and restored whole by checkpoint.c). A field
- *        added here that a step reads must be added to the checkpoint too
- *        (checkpoint.c lists what it holds).
+ * @brief The run in one object (sp_run), grouped by what each part is for.
+ *        Set up and freed by run_setup.h; its layout changes only through
+ *        resize.h; stepped by step.h; its events are events.h's, its
+ *        output the monitor's (monitor.h); saved and restored whole by
+ *        checkpoint.h. A field added here that a step reads must be added
+ *        to the checkpoint too (checkpoint.c lists what it holds).
  *
- * What a step depends on:
+ * What a step depends on (the checkpoint holds exactly this):
  * - the layout and the fields on it: state (c, mu), and the history of
  *   the time scheme, error estimate and predictor (sp_history);
- * - the cell registry: birth (time, mass, reference moments, generation),
- *   source on/off, division skipped, divided this step;
+ * - the cell registry (registry.h);
  * - the time-step controller (sp_dt_control, plain data), step and t;
  * - N_max; the energy history and division times (energy.png); the
  *   summary counters. There is no random state after set-up: the seeded
  *   noise is drawn once, into the initial fields.
- * Everything else (mesh, solver, supports' search structures, per-step
- * buffers) is rebuilt from the scene.
+ * Everything else (options, mesh, solver, the supports' search
+ * structures, per-step buffers) is rebuilt from the scene.
  */
 #ifndef SP_RUN_STATE_H
 #define SP_RUN_STATE_H
 
 #include <mpi.h>
+#include <stddef.h>
 
-#include "cells.h"
 #include "division.h"
 #include "dt_control.h"
 #include "layout.h"
 #include "mesh.h"
 #include "output.h"
-#include "scene.h"
+#include "registry.h"
+#include "run_options.h"
+#include "run_types.h"
 #include "softpack_solver.h"
-#include "stepper.h"
 #include "support.h"
 #include "time_scheme.h"
 
+/** The per-pair buffers of a step on the current layout (resize.h sizes
+ *  them). */
 typedef struct {
-  const sp_scene *scene;
+  double *state_old; /**< c^n of the step in progress */
+  double *state_eff; /**< BDF2: the step's backward-Euler form of c^n (c_hat) */
+  double *scratch;   /**< adaptive: the error estimate's extrapolation */
+  double *source;    /**< per pair: the growth source from c^n */
+} sp_step_buffers;
+
+/** What the monitor (monitor.h) keeps: the output, the energy history of
+ *  energy.png, the costs of the step in progress, the caller's hook. */
+typedef struct {
+  sp_output output;
+  const char *out_dir;  /**< every rank writes its piece there */
+  sp_run_summary *sum;  /**< the caller's: the run's counters, summed once */
+  double *energy_t, *energy_total; /**< the energy history */
+  int n_energy, cap_energy;
+  double *division_t;   /**< division times, marked on energy.png */
+  int n_divisions;
+  sp_step_costs costs;  /**< of the step being attempted (energy.csv) */
+  sp_attempt *attempts; /**< its failed attempts (costs.failed_attempts) */
+  int cap_attempts;
+  double step_start;    /**< wall clock at its first attempt (< 0: none yet) */
+  double t_start;       /**< wall clock at the run's start */
+  double t_checkpoint;  /**< wall clock at the last checkpoint (or start) */
+  sp_step_callback on_step; /**< may be NULL */
+  void *on_step_user;
+  sp_output_field *fields; /**< restarted: the checkpoint's fields.pvd list, */
+  int n_fields;            /**< until the output is opened */
+} sp_monitor;
+
+/** What a checkpoint saves of the scene (may be NULL: none saved, and
+ *  none can be resumed). */
+typedef struct {
+  const char *text; /**< the scene file's text */
+  size_t len;
+  int n_set;        /**< its overrides */
+  const char *const *set;
+} sp_scene_source_text;
+
+typedef struct {
+  sp_run_options opt;   /**< the scene, resolved once (run_options.h) */
+  /* MPI */
+  MPI_Comm comm;
+  MPI_Comm agree_comm;  /**< errors are agreed on it before every collective
+                             (agree.h); MPI errors return codes there */
+  int rank, n_ranks;
+  /* the discretisation */
   sp_mesh *mesh;
   sp_layout *layout;
+  sp_support support;   /**< local supports (NULL: full) */
   sp_solver solver;
-  sp_output output;
-  sp_model_params model;
-  int step;           /* accepted steps so far */
-  double t;           /* time reached */
-  double *state, *state_old; /* the state, and c^n of the step in progress */
-  double *state_eff;  /* the step's backward-Euler form of c^n (BDF2: c_hat) */
-  double *scratch;    /* the error estimate's extrapolation */
-  /* the past states (time scheme, error estimate, solver.predictor) on the
-   * current layout; emptied by a division */
-  sp_history hist;
-  sp_dt_control dtc;  /* how dt is chosen: dt_control.h */
-  sp_cell_obs *obs;
-  double *energy_t, *energy_total; /* the energy history for energy.png */
-  int n_energy, cap_energy;
-  double *division_t; /* division times, marked on energy.png */
-  int n_divisions;
-  int rank, n_ranks;
-  const char *out_dir;   /* the output directory (every rank writes its piece) */
-  /* the cell registry */
-  sp_cell_birth *birth;
-  int *source_on;
-  int *division_skipped; /* due but no field left: reported once */
-  unsigned char *divided_now; /* parent or daughter of a division this step:
-                                 its support may shrink (layout.shrink) */
-  double *source;        /* per pair, from c^n */
-  int n_max;             /* N_max */
-  sp_support support;    /* local supports (NULL: full) */
-  sp_run_summary *sum;
-  sp_division_params division;
-  MPI_Comm comm;
-  MPI_Comm agree_comm; /* errors are agreed on it before every collective
-                          (agree.h); MPI errors return codes there */
-  sp_step_callback on_step; /* may be NULL */
-  void *on_step_user;
-  double t_start;           /* wall clock at the run's start */
-  double t_checkpoint;      /* wall clock at the last checkpoint (or start) */
-  int restarted;            /* 1: continued from a checkpoint (not as initial) */
-  sp_output_field *fields;  /* restarted: the checkpoint's fields.pvd list, */
-  int n_fields;             /* until the output is opened */
-  const char *scene_text;   /* the scene file's text, its overrides: */
-  size_t scene_len;         /* saved in checkpoints (may be NULL) */
-  int n_set;
-  const char *const *set;
+  /* the state */
+  int step;             /**< accepted steps so far */
+  double t;             /**< time reached */
+  double *state;        /**< c and mu on the layout */
+  sp_history hist;      /**< the past states (time scheme, error estimate,
+                             predictor) on the layout; emptied by a division */
+  sp_dt_control dtc;    /**< how dt is chosen: dt_control.h */
+  sp_registry cells;    /**< the cell registry */
+  int n_max;            /**< N_max */
+  sp_division_params division; /**< the division criterion */
+  int restarted;        /**< 1: continued from a checkpoint (not as initial) */
+  /* scratch of a step */
+  sp_step_buffers buf;
+  /* output */
+  sp_monitor mon;
+  sp_scene_source_text scene_text;
 } sp_run;
 
 #endif

@@ -14,6 +14,7 @@
 #include "mesh.h"
 #include "q1.h"
 #include "softpack_solver.h"
+#include "resize.h"
 #include "stepper.h"
 
 /** The paper's parameters (table 1). */

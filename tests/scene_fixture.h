@@ -26,7 +26,7 @@ static inline int scene_run_start(const sp_scene *scene, const sp_run_start *sta
   scene_run *s = calloc(1, sizeof *s);
   *out = NULL;
   if (!s) return sp_error_set(SP_ERR_MEMORY, "out of memory");
-  s->run.sum = &s->sum;
+  s->run.mon.sum = &s->sum;
   const int rc = sp_run_setup(&s->run, scene, MPI_COMM_WORLD, start);
   if (rc != SP_OK) {
     sp_run_free(&s->run);

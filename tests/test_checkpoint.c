@@ -18,6 +18,7 @@
 #include "check.h"
 #include "checkpoint.h"
 #include "error.h"
+#include "resize.h"
 #include "scene_fixture.h"
 
 #define DIR "checkpoint_test"
@@ -45,10 +46,10 @@ static scene_run *fill_run(const sp_scene *scene) {
   sp_run *run = &s->run;
   static const char text[] = "a scene's text";
   static const char *const set[] = {"time.t_end=1", "output.every=3"};
-  run->scene_text = text;
-  run->scene_len = strlen(text);
-  run->n_set = 2;
-  run->set = set;
+  run->scene_text.text = text;
+  run->scene_text.len = strlen(text);
+  run->scene_text.n_set = 2;
+  run->scene_text.set = set;
   const int nn = run->mesh->n_nodes, nc = 3;
   CHECK(run->layout->n_cells == nc, "the scene's set-up has %d cells", run->layout->n_cells);
   unsigned char *mask = malloc((size_t)nn * nc);
@@ -57,7 +58,7 @@ static scene_run *fill_run(const sp_scene *scene) {
   CHECK_OK(sp_layout_create_from_masks(nn, nc, mask, &layout));
   free(mask);
   const size_t nv = 2 * (size_t)layout->n_pairs;
-  CHECK_OK(sp_run_adopt_layout(run, layout, random_array(nv), SP_HISTORY_RESET));
+  CHECK_OK(sp_run_resize(run, layout, random_array(nv), SP_HISTORY_RESET));
   run->hist.n = 2;
   run->hist.past[0] = random_array(nv);
   run->hist.past[1] = random_array(nv);
@@ -67,11 +68,11 @@ static scene_run *fill_run(const sp_scene *scene) {
   run->t = 0.0123;
   run->n_max = 9;
   for (int k = 0; k < nc; ++k) {
-    run->birth[k] = (sp_cell_birth){.birth_time = uniform(), .birth_mass = uniform(),
+    run->cells.birth[k] = (sp_cell_birth){.birth_time = uniform(), .birth_mass = uniform(),
                                     .Iref = {uniform(), uniform()}, .generation = k + 1};
-    run->source_on[k] = k != 1;
-    run->division_skipped[k] = k == 2;
-    run->divided_now[k] = k == 0;
+    run->cells.source_on[k] = k != 1;
+    run->cells.division_skipped[k] = k == 2;
+    run->cells.divided_now[k] = k == 0;
   }
   run->dtc = (sp_dt_control){.dt_next = uniform(), .failures = 2, .successes = 3,
                              .ceiling = uniform(), .ceiling_steps = 4, .since_restart = 5,
@@ -85,11 +86,11 @@ static scene_run *fill_run(const sp_scene *scene) {
                             .t_layout = 0.1, .support_mass_dropped = 1e-14,
                             .support_energy_rise = 0.01, .unknowns_max = 1234,
                             .checkpoints = 3, .t_checkpoints = 0.25};
-  run->n_energy = run->cap_energy = 5;
-  run->energy_t = random_array(5);
-  run->energy_total = random_array(5);
-  run->n_divisions = 2;
-  run->division_t = random_array(2);
+  run->mon.n_energy = run->mon.cap_energy = 5;
+  run->mon.energy_t = random_array(5);
+  run->mon.energy_total = random_array(5);
+  run->mon.n_divisions = 2;
+  run->mon.division_t = random_array(2);
   return s;
 }
 
@@ -117,24 +118,24 @@ static int differences(const sp_run *a, const sp_run *b, int say) {
     DIFF(!memcmp(a->hist.past[i], b->hist.past[i], sizeof(double) * nv), "history past");
   DIFF(b->step == a->step && b->t == a->t && b->n_max == a->n_max, "step, t, n_max");
   for (int k = 0; k < la->n_cells; ++k) {
-    DIFF(b->birth[k].birth_time == a->birth[k].birth_time &&
-         b->birth[k].birth_mass == a->birth[k].birth_mass &&
-         b->birth[k].Iref[0] == a->birth[k].Iref[0] && b->birth[k].Iref[1] == a->birth[k].Iref[1] &&
-         b->birth[k].generation == a->birth[k].generation, "birth");
-    DIFF(b->source_on[k] == a->source_on[k] && b->division_skipped[k] == a->division_skipped[k] &&
-         b->divided_now[k] == a->divided_now[k], "registry");
+    DIFF(b->cells.birth[k].birth_time == a->cells.birth[k].birth_time &&
+         b->cells.birth[k].birth_mass == a->cells.birth[k].birth_mass &&
+         b->cells.birth[k].Iref[0] == a->cells.birth[k].Iref[0] && b->cells.birth[k].Iref[1] == a->cells.birth[k].Iref[1] &&
+         b->cells.birth[k].generation == a->cells.birth[k].generation, "birth");
+    DIFF(b->cells.source_on[k] == a->cells.source_on[k] && b->cells.division_skipped[k] == a->cells.division_skipped[k] &&
+         b->cells.divided_now[k] == a->cells.divided_now[k], "registry");
   }
   sp_dt_control da = a->dtc, db = b->dtc;
   db.p = da.p; /* the parameters come from the scene */
   DIFF(!memcmp(&da, &db, sizeof da), "the controller");
-  DIFF(!memcmp(a->sum, b->sum, sizeof *a->sum), "the summary");
-  DIFF(b->n_energy == a->n_energy && b->n_divisions == a->n_divisions, "energy history sizes");
-  if (b->n_energy == a->n_energy) {
-    DIFF(!memcmp(a->energy_t, b->energy_t, sizeof(double) * a->n_energy), "energy_t");
-    DIFF(!memcmp(a->energy_total, b->energy_total, sizeof(double) * a->n_energy), "energy_total");
+  DIFF(!memcmp(a->mon.sum, b->mon.sum, sizeof *a->mon.sum), "the summary");
+  DIFF(b->mon.n_energy == a->mon.n_energy && b->mon.n_divisions == a->mon.n_divisions, "energy history sizes");
+  if (b->mon.n_energy == a->mon.n_energy) {
+    DIFF(!memcmp(a->mon.energy_t, b->mon.energy_t, sizeof(double) * a->mon.n_energy), "energy_t");
+    DIFF(!memcmp(a->mon.energy_total, b->mon.energy_total, sizeof(double) * a->mon.n_energy), "energy_total");
   }
-  if (b->n_divisions == a->n_divisions)
-    DIFF(!memcmp(a->division_t, b->division_t, sizeof(double) * a->n_divisions), "division_t");
+  if (b->mon.n_divisions == a->mon.n_divisions)
+    DIFF(!memcmp(a->mon.division_t, b->mon.division_t, sizeof(double) * a->mon.n_divisions), "division_t");
 #undef DIFF
   return n;
 }
@@ -168,8 +169,8 @@ static void round_trip(const sp_scene *scene) {
   int n_set;
   const char *const *set;
   const char *text = sp_checkpoint_scene(ck, &len, &n_set, &set);
-  CHECK(len == a->scene_len && memcmp(text, a->scene_text, len) == 0, "scene text");
-  CHECK(n_set == 2 && strcmp(set[0], a->set[0]) == 0 && strcmp(set[1], a->set[1]) == 0,
+  CHECK(len == a->scene_text.len && memcmp(text, a->scene_text.text, len) == 0, "scene text");
+  CHECK(n_set == 2 && strcmp(set[0], a->scene_text.set[0]) == 0 && strcmp(set[1], a->scene_text.set[1]) == 0,
         "overrides");
   sp_checkpoint_close(&ck);
   CHECK_OK(restore(path, scene, &sb));

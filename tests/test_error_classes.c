@@ -19,6 +19,7 @@
 #include "layout.h"
 #include "run.h"
 #include "solver_status.h"
+#include "resize.h"
 #include "stepper.h"
 
 static const char scene[] =

@@ -1,0 +1,32 @@
+/**
+ * @file cell_obs.h
+ * @brief What is observed of each cell after a step (public: a step
+ *        callback sees them, run_types.h); computed by cells.h.
+ */
+#ifndef SP_CELL_OBS_H
+#define SP_CELL_OBS_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Observables of one cell (MODEL.md, shape penalty, for the tensor). */
+typedef struct {
+  double mass;      /**< m_k = int c_k dV (the conserved quantity) */
+  double mass_core; /**< int c_k dV over c_k >= weight_threshold only: the
+                         cell without its background (division, source) */
+  double xc, yc;    /**< centre of mass int c X / int c */
+  double Ixx, Iyy, Ixy; /**< inertia tensor [[Ixx, Ixy],[Ixy, Iyy]] about
+                             the centre: Ixx = int c Xb2^2, Iyy = int c Xb1^2,
+                             Ixy = -int c Xb1 Xb2 */
+  double I1, I2;    /**< principal moments, I1 >= I2 */
+  double v1[2], v2[2]; /**< unit eigenvectors of I1 and I2 */
+  double angle;     /**< angle of v1 from the x axis, in (-pi/2, pi/2] */
+  double area;      /**< area where c_k >= 1/2 (inside the membrane; at the
+                         quadrature points, whatever the weight threshold) */
+} sp_cell_obs;
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,194 @@
+/* The run's events (events.h). */
+#include "events.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cells.h"
+#include "division.h"
+#include "error.h"
+#include "layout.h"
+#include "monitor.h"
+#include "resize.h"
+#include "source.h"
+#include "support.h"
+
+double sp_events_next(const sp_run *run, double t) {
+  const double t_end = run->opt.time.t_end, slack = 1e-12 * t_end;
+  double event = t_end;
+  const double every = run->opt.output.interval;
+  if (every > 0) {
+    const double k = floor((t + slack) / every) + 1;
+    event = fmin(event, k * every);
+  }
+  if (run->opt.time.adaptive && run->opt.division.criterion == SP_DIVIDE_BY_AGE &&
+      run->layout->n_cells < run->n_max) {
+    for (int k = 0; k < run->layout->n_cells; ++k) {
+      const double due = run->cells.birth[k].birth_time + run->opt.division.t_div;
+      if (due > t + slack) event = fmin(event, due);
+    }
+  }
+  return event;
+}
+
+int sp_events_on_output_time(const sp_run *run, double t) {
+  const double every = run->opt.output.interval;
+  if (!(every > 0)) return 0;
+  const double k = floor(t / every + 0.5);
+  return k > 0 && fabs(t - k * every) <= 1e-12 * run->opt.time.t_end;
+}
+
+int sp_events_landing(sp_run *run, sp_step_attempt *a, double *theta) {
+  *theta = 1.0;
+  const sp_registry *cells = &run->cells;
+  const int n_cells = run->layout->n_cells;
+  if (!(run->opt.time.adaptive && run->opt.division.criterion == SP_DIVIDE_BY_MASS &&
+        n_cells < run->n_max))
+    return SP_OK;
+  /* observed here, kept if the step stands */
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
+                           run->opt.division.observe_threshold, cells->obs_new));
+  a->observed = 1;
+  for (int k = 0; k < n_cells; ++k) {
+    const double m_old = cells->obs[k].mass_core, m_new = cells->obs_new[k].mass_core;
+    if (!sp_division_due(&run->division, &cells->birth[k], a->t, a->t + a->dt, m_old, m_new))
+      continue;
+    const double f = sp_division_crossing_fraction(&run->division, &cells->birth[k], a->t,
+                                                   a->t + a->dt, m_old, m_new);
+    /* overshot: past the threshold by more than the tolerance */
+    const double over = m_new - sp_division_threshold(&run->division, &cells->birth[k]) *
+                                    (1 + SP_MASS_LANDING_TOLERANCE);
+    if (f > 0 && f < 1 && over > 0) *theta = fmin(*theta, f);
+  }
+  return SP_OK;
+}
+
+/** Local supports: recompute every support from the fields (they follow
+ *  the cells), keeping each cell's mass exactly. */
+static int update_supports(sp_run *run, sp_step_events *ev) {
+  const double t0 = sp_wall_clock();
+  sp_layout *layout;
+  double *state, correction, dropped;
+  sp_energy_parts before;
+  SP_CALL(sp_run_energy(run, &before));
+  SP_CALL(sp_support_rebuild(run->support, run->layout, run->state,
+                             run->opt.terms.shrink_always ? NULL : run->cells.divided_now, &layout,
+                             &state, &correction, &dropped));
+  memset(run->cells.divided_now, 0, (size_t)run->layout->n_cells);
+  SP_CALL(sp_run_resize(run, layout, state, SP_HISTORY_CARRY));
+  SP_CALL(sp_run_energy(run, &ev->energy));
+  ev->have_energy = 1;
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
+                           run->opt.division.observe_threshold, run->cells.obs));
+  const double e_before = sp_energy_fields(&before);
+  ev->support_changed = 1;
+  ev->mass_correction = correction;
+  ev->mass_dropped = dropped;
+  ev->energy_rise = (sp_energy_fields(&ev->energy) - e_before) / fabs(e_before);
+  ev->t_supports = sp_wall_clock() - t0;
+  return SP_OK;
+}
+
+/** The layout after a division: full, or every support as it is plus the
+ *  child on the parent's support (the next update tightens both). */
+static int layout_with_child(sp_run *run, int parent, sp_layout **out) {
+  const int n = run->layout->n_cells, nn = run->mesh->n_nodes;
+  if (!run->support) return sp_layout_create_full(nn, n + 1, out);
+  return sp_layout_with_child(run->layout, parent, out);
+}
+
+/** The split state of a division of @p parent on @p new_layout, the child
+ *  being its last cell (the division line through the centre, or moved to
+ *  halve the mass: division.line). */
+static int split_state(sp_run *run, int parent, const sp_cell_obs *parent_obs,
+                       const sp_layout *new_layout, double *new_state) {
+  const sp_run_division *dv = &run->opt.division;
+  double offset = 0.0;
+  if (dv->equal_mass_line)
+    SP_CALL(sp_division_balance_offset(run->mesh, run->layout, run->state, parent, parent_obs,
+                                       dv->smooth_cut, dv->interface_width, &offset));
+  return sp_division_split(run->mesh, run->layout, run->state, parent, parent_obs,
+                           dv->smooth_cut, dv->interface_width, offset, new_layout, new_state,
+                           new_layout->n_cells - 1);
+}
+
+/**
+ * Divide cell @p parent (paper algorithm 1): a new layout with one more
+ * cell, the split state on it, the registry entries of both daughters, a
+ * row of divisions.csv.
+ */
+static int divide_cell(sp_run *run, int parent) {
+  const int n = run->layout->n_cells, child = n;
+  sp_layout *new_layout = NULL;
+  SP_CALL(layout_with_child(run, parent, &new_layout));
+  double *new_state = calloc(2 * (size_t)new_layout->n_pairs, sizeof(double));
+  if (!new_state) {
+    sp_layout_destroy(&new_layout);
+    return sp_error_set(SP_ERR_MEMORY, "out of memory dividing cell %d", parent + 1);
+  }
+  const sp_cell_obs parent_obs = run->cells.obs[parent];
+  const int rc = split_state(run, parent, &parent_obs, new_layout, new_state);
+  if (rc != SP_OK) {
+    free(new_state);
+    sp_layout_destroy(&new_layout);
+    return rc;
+  }
+  SP_CALL(sp_run_resize(run, new_layout, new_state, SP_HISTORY_RESET));
+  sp_registry *cells = &run->cells;
+  cells->divided_now[parent] = cells->divided_now[child] = 1;
+  cells->source_on[child] = cells->source_on[parent];
+  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
+                           run->opt.division.observe_threshold, cells->obs));
+  sp_cells_core_view(cells->obs, n + 1, cells->obs_new); /* (scratch) */
+  sp_division_record_births(run->t, cells->obs_new, parent, child, cells->birth);
+  double px, py, dx, dy;
+  sp_division_axis(&parent_obs, &px, &py, &dx, &dy);
+  double angle = atan2(dy, dx);
+  if (angle <= -M_PI / 2) angle += M_PI;
+  if (angle > M_PI / 2) angle -= M_PI;
+  return sp_monitor_division(run, parent, child, angle, parent_obs.mass);
+}
+
+/** After the step from @p t_old: divide every cell whose criterion was
+ *  crossed (daughters born now wait a step). */
+static int divide_due_cells(sp_run *run, double t_old, int *n_divided) {
+  *n_divided = 0;
+  if (run->opt.division.criterion == SP_DIVIDE_NONE) return SP_OK;
+  const int n = run->layout->n_cells;
+  for (int k = 0; k < n; ++k) {
+    sp_registry *cells = &run->cells;
+    if (!sp_division_due(&run->division, &cells->birth[k], t_old, run->t,
+                         cells->core_mass_old[k], cells->obs[k].mass_core))
+      continue;
+    if (run->layout->n_cells >= run->n_max) {
+      if (!cells->division_skipped[k] && run->rank == 0)
+        fprintf(stderr, "softpack: cell %d is due to divide at t = %.6g but N_max = %d cells "
+                        "exist already; it does not divide\n", k + 1, run->t, run->n_max);
+      cells->division_skipped[k] = 1;
+      continue;
+    }
+    SP_CALL(divide_cell(run, k));
+    ++*n_divided;
+  }
+  return SP_OK;
+}
+
+int sp_events_after_step(sp_run *run, const sp_step_attempt *a, sp_step_events *ev) {
+  *ev = (sp_step_events){0};
+  SP_CALL(divide_due_cells(run, a->t, &ev->n_divided));
+  int outgrown = 0; /* a cell reaches its support's edge */
+  if (run->support && !ev->n_divided)
+    SP_CALL(sp_support_needs_update(run->support, run->layout, run->state, &outgrown));
+  if (run->support && (ev->n_divided || outgrown)) SP_CALL(update_supports(run, ev));
+  if (ev->n_divided) sp_dt_restart(&run->dtc, sp_step_first_dt(run)); /* algorithm 2, or a new first step */
+  if (run->opt.terms.source_rate > 0) {
+    sp_registry *cells = &run->cells;
+    for (int k = 0; k < run->layout->n_cells; ++k) cells->core_mass[k] = cells->obs[k].mass_core;
+    SP_CALL(sp_source_update_switch(run->layout->n_cells, run->n_max, cells->core_mass,
+                                    cells->birth, cells->source_on,
+                                    run->opt.terms.source_off_ratio));
+  }
+  return SP_OK;
+}

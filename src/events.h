@@ -1,0 +1,62 @@
+/**
+ * @file events.h
+ * @brief The run's events in one place: the times a step must land on
+ *        (t_end, output times, age divisions), the mass criterion's landing
+ *        rule inside an attempt, and what happens after an accepted step:
+ *        divisions (algorithm 1), the local supports' change, the
+ *        controller's restart after a division, the source switch.
+ */
+#ifndef SP_EVENTS_H
+#define SP_EVENTS_H
+
+#include "run_state.h"
+#include "softpack_solver.h"
+#include "step.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Adaptive control, mass criterion: a step whose end overshoots a cell's
+ *  division mass by more than this (relative) is redone, shortened to the
+ *  interpolated crossing (sp_division_crossing_fraction); a landing within
+ *  it counts as the crossing (sp_division_params.tolerance). */
+#define SP_MASS_LANDING_TOLERANCE 1e-3
+
+/** What the events after a step did (the monitor reports it). */
+typedef struct {
+  int n_divided;         /**< divisions */
+  int support_changed;   /**< the local supports were rebuilt */
+  double t_supports;     /**< seconds rebuilding them */
+  double mass_correction; /**< the largest relative mass change it restored */
+  double mass_dropped;   /**< |total after - total before| / total */
+  double energy_rise;    /**< relative rise of the field energy (may be < 0) */
+  int have_energy;       /**< energy: the field energy of the new state */
+  sp_energy_parts energy;
+} sp_step_events;
+
+/** @brief The next time a step must land on after @p t: t_end, the next
+ *         output time (output.interval), and with adaptive control the
+ *         next age division. */
+double sp_events_next(const sp_run *run, double t);
+
+/** @brief 1 if @p t is a multiple of output.interval (to round-off). */
+int sp_events_on_output_time(const sp_run *run, double t);
+
+/** @brief Adaptive control, mass criterion, N < N_max: the observables of
+ *         the attempt's end (into run->cells.obs_new, a->observed = 1) and
+ *         the fraction @p theta of the attempt at which the first mass
+ *         division due in it was reached when it overshot by more than
+ *         SP_MASS_LANDING_TOLERANCE; 1 otherwise. */
+int sp_events_landing(sp_run *run, sp_step_attempt *a, double *theta);
+
+/** @brief After the accepted step @p a (sp_step_complete'd): every cell
+ *         whose criterion was crossed divides, the supports follow the
+ *         cells, the controller restarts after divisions, the source
+ *         switches. Collective. */
+int sp_events_after_step(sp_run *run, const sp_step_attempt *a, sp_step_events *ev);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,164 @@
+/* One step: an attempt with a verdict, and its completion (step.h). */
+#include "step.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "agree.h"
+#include "cells.h"
+#include "error.h"
+#include "events.h"
+#include "fault.h"
+#include "monitor.h"
+#include "shape.h"
+#include "solver_status.h"
+#include "source.h"
+#include "time_scheme.h"
+
+/** solver.predictor linear: the last increment is scaled by dt / dt_last,
+ *  at most this much (algorithm 2's ramp multiplies dt by up to 64). */
+#define SP_PREDICTOR_MAX_RATIO 2.0
+
+double sp_step_first_dt(const sp_run *run) {
+  const sp_dt_params *p = &run->opt.time.dt;
+  const double dt =
+      sp_scheme_first_dt(run->layout, run->state, &run->opt.model, fmin(p->dt, p->dt_max));
+  return fmax(dt, p->dt_min);
+}
+
+void sp_step_begin(sp_run *run) {
+  if (run->restarted) sp_dt_resume(&run->dtc, &run->opt.time.dt); /* state: the checkpoint's */
+  else sp_dt_init(&run->dtc, &run->opt.time.dt, sp_step_first_dt(run));
+}
+
+int sp_step_run_ends(const sp_run *run) {
+  const sp_run_time *tc = &run->opt.time;
+  return !(run->t < tc->t_end - 1e-12 * tc->t_end && run->step < tc->max_steps);
+}
+
+/** The step's source and shape coefficients from c^n (the state before the
+ *  step and its observables). */
+static int explicit_terms(sp_run *run) {
+  const sp_run_terms *terms = &run->opt.terms;
+  sp_registry *cells = &run->cells;
+  const int n_cells = run->layout->n_cells;
+  if (terms->source_rate > 0)
+    SP_CALL(sp_source_fill(run->layout, run->buf.state_old, n_cells, cells->source_on,
+                           terms->source_rate, run->buf.source));
+  if (!(terms->shape_delta1 > 0 || terms->shape_delta2 > 0)) return SP_OK;
+  /* from the observables of c^n; implicit steps follow the new moments
+   * through the gains */
+  SP_CALL(sp_shape_coefficients(n_cells, cells->obs, cells->birth, terms->shape_delta1,
+                                terms->shape_delta2, cells->shape));
+  /* the term is the derivative of the moments, which count c only where
+   * c >= the observables' threshold: it acts there only */
+  for (int k = 0; k < n_cells; ++k) cells->shape[k].threshold = run->opt.division.observe_threshold;
+  return SP_OK;
+}
+
+/** The step's data for the solver: backward Euler from c^n, or BDF2 in its
+ *  backward-Euler form from c_hat (time_scheme.h); Newton's error a small
+ *  part of the step's under adaptive control. */
+static sp_step_data step_data(sp_run *run, sp_scheme_kind kind, double dt) {
+  const sp_run_options *o = &run->opt;
+  sp_step_data data = {.dt = dt, .model = o->model, .state_old = run->buf.state_old,
+                       .source = o->terms.source_rate > 0 ? run->buf.source : NULL,
+                       .shape = o->terms.shape_delta1 > 0 || o->terms.shape_delta2 > 0
+                                    ? run->cells.shape : NULL,
+                       .shape_implicit = o->terms.shape_implicit};
+  if (kind != SP_SCHEME_BE) {
+    sp_scheme_be_form(kind, &run->hist, dt, run->buf.state_old, (size_t)run->layout->n_pairs,
+                      run->buf.state_eff, &data.dt);
+    data.state_old = run->buf.state_eff;
+  }
+  if (o->time.adaptive) {
+    data.update_rtol = SP_SCHEME_NEWTON_FRACTION * o->time.rtol;
+    data.update_atol = SP_SCHEME_NEWTON_FRACTION * o->time.atol;
+  }
+  return data;
+}
+
+/** The verdict on a solved attempt (Newton's status @p solved): the
+ *  controller's on Newton and on the error estimate, then the landing
+ *  rule of the mass criterion (events.h). */
+static int judge(sp_run *run, sp_scheme_kind kind, int solved, sp_step_attempt *a) {
+  const sp_run_time *tc = &run->opt.time;
+  a->why = a->report.reason;
+  if (solved == 0 && tc->adaptive) {
+    a->err = sp_scheme_error(kind, &run->hist, a->dt, run->buf.state_old, run->state,
+                             (size_t)run->layout->n_pairs, tc->rtol, tc->atol, run->buf.scratch);
+    snprintf(a->why_text, sizeof a->why_text,
+             "local error estimate %.3g x the tolerance (time.rtol, time.atol)", a->err);
+    a->why = a->why_text;
+  }
+  if (solved != 0) {
+    a->verdict = SP_STEP_NEWTON_FAILED;
+    a->give_up = sp_dt_newton_failed(&run->dtc, a->dt);
+    return SP_OK;
+  }
+  if (sp_dt_judge(&run->dtc, a->dt, a->err) == SP_DT_REJECT) {
+    a->verdict = SP_STEP_ERROR_TOO_LARGE;
+    a->give_up = sp_dt_give_up(&run->dtc);
+    return SP_OK;
+  }
+  double theta;
+  SP_CALL(sp_events_landing(run, a, &theta));
+  if (theta < 1) { /* land on the crossing: redo the step shorter */
+    sp_dt_land(&run->dtc, theta * a->dt);
+    a->why = "a cell's mass passed its division mass inside the step (landing on it)";
+    a->err = -1.0;
+    a->verdict = SP_STEP_LANDING;
+    return SP_OK;
+  }
+  a->verdict = SP_STEP_ACCEPTED;
+  return SP_OK;
+}
+
+int sp_step_try(sp_run *run, sp_step_attempt *a) {
+  *a = (sp_step_attempt){.verdict = SP_STEP_FATAL, .wall_start = sp_wall_clock(), .t = run->t,
+                         .err = -1.0};
+  const size_t n_pairs = (size_t)run->layout->n_pairs, n_values = 2 * n_pairs;
+  const double t_event = sp_events_next(run, run->t);
+  a->dt = sp_dt_propose(&run->dtc, run->t, t_event, &a->lands);
+  a->t_new = a->lands ? t_event : run->t + a->dt;
+  memcpy(run->buf.state_old, run->state, n_values * sizeof(double));
+  if (run->opt.time.predictor_linear) /* Newton starts from the extrapolation */
+    sp_scheme_extrapolate(1, &run->hist,
+                          run->hist.n >= 1 ? fmin(a->dt, SP_PREDICTOR_MAX_RATIO * run->hist.dt[0])
+                                           : a->dt,
+                          run->buf.state_old, n_pairs, run->state);
+  int rc = explicit_terms(run);
+  if (rc == SP_OK) rc = sp_fault_check(SP_FAULT_STEP, run->rank);
+  SP_CALL(sp_agree(run->agree_comm, rc)); /* Newton's collectives follow */
+  const sp_scheme_kind kind = sp_scheme_of_step(run->opt.time.scheme, &run->hist);
+  const sp_step_data data = step_data(run, kind, a->dt);
+  const int solved = sp_solver_step(run->solver, &data, run->state, &a->report);
+  if (solved > SP_SOLVER_NOT_CONVERGED)
+    return sp_solver_failed(run->solver, solved, "step %d at t = %g", run->step + 1, run->t);
+  SP_CALL(judge(run, kind, solved, a));
+  if (a->verdict != SP_STEP_ACCEPTED) /* retried from the last good state */
+    memcpy(run->state, run->buf.state_old, n_values * sizeof(double));
+  return SP_OK;
+}
+
+int sp_step_complete(sp_run *run, const sp_step_attempt *a) {
+  const sp_run_options *o = &run->opt;
+  sp_registry *cells = &run->cells;
+  const int n_cells = run->layout->n_cells;
+  const size_t n_values = 2 * (size_t)run->layout->n_pairs;
+  run->t = a->t_new;
+  ++run->step;
+  sp_dt_accepted(&run->dtc, a->dt, a->err);
+  /* the past states: for the scheme, the error estimate, the predictor */
+  if (o->time.adaptive || o->time.scheme == SP_SCHEME_BDF2 || o->time.predictor_linear)
+    SP_CALL(sp_history_push(&run->hist, run->buf.state_old, a->dt, n_values));
+  /* the core masses before the step, for crossing-safe criteria */
+  for (int k = 0; k < n_cells; ++k) cells->core_mass_old[k] = cells->obs[k].mass_core;
+  if (a->observed) {
+    memcpy(cells->obs, cells->obs_new, sizeof *cells->obs * (size_t)n_cells);
+    return SP_OK;
+  }
+  return sp_cells_observe(run->mesh, run->layout, run->state, o->division.observe_threshold,
+                          cells->obs);
+}
