@@ -4,8 +4,9 @@
 # changes the machine: docs/install.md gives the commands by hand).
 #   deb_package.sh BUILD_DIR CPACK VERSION SONAME_VERSION LIBDIR RUNTIME_PACKAGE...
 # Checks: the control fields (name, version, Depends naming openmpi-bin and
-# every runtime package CMake lists), the files under /usr, and the
-# unpacked bin/softpack running with the libsoftpack beside it.
+# every runtime package CMake lists), the files under /usr (the headers
+# exactly the public ones, as tests/install_tree.sh checks of the tree),
+# and the unpacked bin/softpack running with the libsoftpack beside it.
 # Exit status 77 (skipped) without dpkg-deb.
 set -euo pipefail
 build=$1 cpack=$2 version=$3 soversion=$4 lib=$5
@@ -30,13 +31,23 @@ for package in openmpi-bin "$@"; do
 done
 
 dpkg-deb -c "$deb" | awk '{print $6}' > "$tmp/files"
-for f in ./usr/bin/softpack "./usr/$lib/libsoftpack.so.$soversion" ./usr/include/softpack/scene.h \
+for f in ./usr/bin/softpack "./usr/$lib/libsoftpack.so.$soversion" ./usr/include/softpack/run.h \
          "./usr/$lib/cmake/softpack/softpackConfig.cmake" "./usr/$lib/pkgconfig/softpack.pc" \
          ./usr/share/softpack/inputs/default.yaml ./usr/share/softpack/inputs/paper/embryo_8.yaml \
          ./usr/share/softpack/doc/README.md; do
   grep -qxF "$f" "$tmp/files" || fail "the package has no $f"
 done
-echo "$(wc -l < "$tmp/files") entries, the expected files among them"
+public="./usr/include/softpack/cell_obs.h
+./usr/include/softpack/error.h
+./usr/include/softpack/run.h
+./usr/include/softpack/run_types.h
+./usr/include/softpack/softpack_newton.h"
+headers=$(grep '^\./usr/include/.*[^/]$' "$tmp/files" | LC_ALL=C sort)
+[ "$headers" = "$public" ] || {
+  diff <(echo "$public") <(echo "$headers") >&2 || true
+  fail "the package's include/ holds other than the public headers (< expected, > packaged)"
+}
+echo "$(wc -l < "$tmp/files") entries, the expected files among them, the public headers only"
 
 dpkg-deb -x "$deb" "$tmp/root"
 out=$(OMP_NUM_THREADS=1 "$tmp/root/usr/bin/softpack" --version)
