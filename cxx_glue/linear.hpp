@@ -1,7 +1,9 @@
 // Direct linear solvers behind one small interface on plain CSR arrays, so
 // the Newton code never depends on a backend and the backends never see the
 // Jacobian's Epetra objects (a later move to Tpetra is cheap). The Amesos
-// backends build their own Epetra matrix from the arrays (linear_amesos.cpp).
+// backends factor the Jacobian itself where CsrRows.matrix offers it (one
+// process), and otherwise build an Epetra matrix of their own from the
+// arrays (linear_amesos.cpp, epetra_rows.hpp).
 #ifndef SP_LINEAR_HPP
 #define SP_LINEAR_HPP
 
@@ -24,8 +26,9 @@ namespace sp {
 // sorted copy of the Jacobian's rows, linear_gather's gathered rows), so a
 // backend that works in place (SuperLU_DIST scales and permutes them)
 // needs no copy of its own, and one that only reads them during the call
-// (serial SuperLU) neither. The Jacobian's values then exist twice per
-// rank: the Epetra matrix and those rows (docs/design.md).
+// (serial SuperLU) neither. How many copies of the Jacobian's values that
+// makes per backend and process count: docs/design.md ("How many copies of
+// the Jacobian"; once on one process for serial SuperLU, MUMPS and KLU).
 struct CsrRows {
   int n_global = 0;
   int first_row = 0;

@@ -683,6 +683,46 @@ static int read_doubles(const sp_checkpoint ck, const char *name, double **p, in
   return get_array(ck, name, H5T_NATIVE_DOUBLE, q, (size_t)n);
 }
 
+/** The time scheme's history (past states of @p n_values values). */
+static int read_history(const sp_checkpoint ck, sp_history *h, size_t n_values) {
+  h->n = ck->header[H_HIST_N];
+  SP_CHECK(h->n >= 0 && h->n <= 2, SP_ERR_INPUT, "checkpoint '%s': /history damaged", ck->path);
+  h->dt[0] = ck->header_t[H_DT0];
+  h->dt[1] = ck->header_t[H_DT1];
+  for (int i = 0; i < h->n; ++i) {
+    h->past[i] = malloc(sizeof(double) * n_values + 1);
+    SP_CHECK(h->past[i], SP_ERR_MEMORY, "out of memory for the history");
+    SP_CALL(get_array(ck, i == 0 ? "/history/past0" : "/history/past1", H5T_NATIVE_DOUBLE,
+                      h->past[i], n_values));
+  }
+  return SP_OK;
+}
+
+/** The registry of @p nc cells (sized and zeroed by the caller). */
+static int read_registry(const sp_checkpoint ck, sp_registry *cells, int nc) {
+  double *col = malloc(sizeof(double) * (2 * (size_t)nc + 1));
+  int *icol = malloc(sizeof(int) * ((size_t)nc + 1));
+  int rc = col && icol ? SP_OK : sp_error_set(SP_ERR_MEMORY, "out of memory");
+  if (rc == SP_OK) rc = get_array(ck, "/cells/birth_time", H5T_NATIVE_DOUBLE, col, nc);
+  for (int k = 0; rc == SP_OK && k < nc; ++k) cells->birth[k].birth_time = col[k];
+  if (rc == SP_OK) rc = get_array(ck, "/cells/birth_mass", H5T_NATIVE_DOUBLE, col, nc);
+  for (int k = 0; rc == SP_OK && k < nc; ++k) cells->birth[k].birth_mass = col[k];
+  if (rc == SP_OK) rc = get_array(ck, "/cells/Iref", H5T_NATIVE_DOUBLE, col, 2 * (size_t)nc);
+  for (int k = 0; rc == SP_OK && k < nc; ++k) {
+    cells->birth[k].Iref[0] = col[2 * k];
+    cells->birth[k].Iref[1] = col[2 * k + 1];
+  }
+  if (rc == SP_OK) rc = get_array(ck, "/cells/generation", H5T_NATIVE_INT, icol, nc);
+  for (int k = 0; rc == SP_OK && k < nc; ++k) cells->birth[k].generation = icol[k];
+  free(col);
+  free(icol);
+  SP_CALL(rc);
+  SP_CALL(get_array(ck, "/cells/source_on", H5T_NATIVE_INT, cells->source_on, nc));
+  SP_CALL(get_array(ck, "/cells/division_skipped", H5T_NATIVE_INT, cells->division_skipped, nc));
+  SP_CALL(get_array(ck, "/cells/divided_now", H5T_NATIVE_UCHAR, cells->divided_now, nc));
+  return SP_OK;
+}
+
 int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
                           sp_output_field **fields, int *n_fields) {
   *fields = NULL;
@@ -703,39 +743,8 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
   const int nc = layout->n_cells;
   const size_t n_values = 2 * (size_t)layout->n_pairs;
   if (as_initial) return SP_OK; /* the caller makes the registry of a new run */
-  /* the history */
-  sp_history *h = &run->hist;
-  h->n = ck->header[H_HIST_N];
-  SP_CHECK(h->n >= 0 && h->n <= 2, SP_ERR_INPUT, "checkpoint '%s': /history damaged", ck->path);
-  h->dt[0] = ck->header_t[H_DT0];
-  h->dt[1] = ck->header_t[H_DT1];
-  for (int i = 0; i < h->n; ++i) {
-    h->past[i] = malloc(sizeof(double) * n_values + 1);
-    SP_CHECK(h->past[i], SP_ERR_MEMORY, "out of memory for the history");
-    SP_CALL(get_array(ck, i == 0 ? "/history/past0" : "/history/past1", H5T_NATIVE_DOUBLE,
-                      h->past[i], n_values));
-  }
-  /* the registry */
-  double *col = malloc(sizeof(double) * (2 * (size_t)nc + 1));
-  int *icol = malloc(sizeof(int) * ((size_t)nc + 1));
-  int rc = col && icol ? SP_OK : sp_error_set(SP_ERR_MEMORY, "out of memory");
-  if (rc == SP_OK) rc = get_array(ck, "/cells/birth_time", H5T_NATIVE_DOUBLE, col, nc);
-  for (int k = 0; rc == SP_OK && k < nc; ++k) run->cells.birth[k].birth_time = col[k];
-  if (rc == SP_OK) rc = get_array(ck, "/cells/birth_mass", H5T_NATIVE_DOUBLE, col, nc);
-  for (int k = 0; rc == SP_OK && k < nc; ++k) run->cells.birth[k].birth_mass = col[k];
-  if (rc == SP_OK) rc = get_array(ck, "/cells/Iref", H5T_NATIVE_DOUBLE, col, 2 * (size_t)nc);
-  for (int k = 0; rc == SP_OK && k < nc; ++k) {
-    run->cells.birth[k].Iref[0] = col[2 * k];
-    run->cells.birth[k].Iref[1] = col[2 * k + 1];
-  }
-  if (rc == SP_OK) rc = get_array(ck, "/cells/generation", H5T_NATIVE_INT, icol, nc);
-  for (int k = 0; rc == SP_OK && k < nc; ++k) run->cells.birth[k].generation = icol[k];
-  free(col);
-  free(icol);
-  SP_CALL(rc);
-  SP_CALL(get_array(ck, "/cells/source_on", H5T_NATIVE_INT, run->cells.source_on, nc));
-  SP_CALL(get_array(ck, "/cells/division_skipped", H5T_NATIVE_INT, run->cells.division_skipped, nc));
-  SP_CALL(get_array(ck, "/cells/divided_now", H5T_NATIVE_UCHAR, run->cells.divided_now, nc));
+  SP_CALL(read_history(ck, &run->hist, n_values));
+  SP_CALL(read_registry(ck, &run->cells, nc));
   /* the controller, the counters, step and time */
   SP_CALL(get_members(ck->file, ck->path, "/controller", &run->dtc, controller_members,
                       N_OF(controller_members)));

@@ -54,6 +54,14 @@ typedef struct {
                           get the parent's generation + 1 */
 } sp_cell_birth;
 
+/** A division, as divisions.csv reports it. */
+typedef struct {
+  int parent, child;
+  double angle;          /**< of the division axis, in (-pi/2, pi/2] */
+  double parent_mass;    /**< before the cut */
+  double mass_a, mass_b; /**< the daughters' right after it */
+} sp_division_record;
+
 /** Division criterion (MODEL.md "Division"), chosen per scene. */
 typedef enum {
   SP_DIVIDE_AGE = 0, /**< divide when t - birth_time reaches T_div */

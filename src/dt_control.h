@@ -2,15 +2,18 @@
  * @file dt_control.h
  * @brief How dt is chosen: the one time-step controller (in the spirit of
  *        PETSc's TSAdapt and SUNDIALS' SUNAdaptController). Every dt
- *        decision of a run lives here; the time loop (stepper.c) only asks
- *        for a step, reports what happened and obeys.
+ *        decision of a run lives here; the step (step.c) asks for a dt,
+ *        reports what happened and obeys, and nothing else writes the
+ *        controller's fields:
  *
- * The loop talks to it in four calls:
- *
- *     dt = sp_dt_propose(&c, t, t_event);          the step to try
+ *     sp_dt_init(&c, &p, dt_first);                 a new run's first step
+ *     sp_dt_resume(&c, &p);                         a run from a checkpoint
+ *     dt = sp_dt_propose(&c, t, t_event, &lands);   the step to try
  *     ...solve...
  *     Newton failed:          give_up = sp_dt_newton_failed(&c, dt);
- *     error estimate err:     if (sp_dt_judge(&c, dt, err) == SP_DT_REJECT) retry;
+ *     error estimate err:     if (sp_dt_judge(&c, dt, err) == SP_DT_REJECT)
+ *                               give_up = sp_dt_give_up(&c);
+ *     overshot a mass event:  sp_dt_land(&c, theta * dt);
  *     accepted:               sp_dt_accepted(&c, dt, err);
  *     a cell divided:         sp_dt_restart(&c, dt_first);
  *

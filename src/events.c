@@ -10,10 +10,12 @@
 #include "division.h"
 #include "error.h"
 #include "layout.h"
-#include "monitor.h"
 #include "resize.h"
+#include "run_energy.h"
 #include "source.h"
 #include "support.h"
+#include "time_scheme.h"
+#include "wall_clock.h"
 
 double sp_events_next(const sp_run *run, double t) {
   const double t_end = run->opt.time.t_end, slack = 1e-12 * t_end;
@@ -40,7 +42,14 @@ int sp_events_on_output_time(const sp_run *run, double t) {
   return k > 0 && fabs(t - k * every) <= 1e-12 * run->opt.time.t_end;
 }
 
-int sp_events_landing(sp_run *run, sp_step_attempt *a, double *theta) {
+double sp_events_first_dt(const sp_run *run) {
+  const sp_dt_params *p = &run->opt.time.dt;
+  const double dt =
+      sp_scheme_first_dt(run->layout, run->state, &run->opt.model, fmin(p->dt, p->dt_max));
+  return fmax(dt, p->dt_min);
+}
+
+int sp_events_landing(sp_run *run, double t, double dt, int *observed, double *theta) {
   *theta = 1.0;
   const sp_registry *cells = &run->cells;
   const int n_cells = run->layout->n_cells;
@@ -50,13 +59,13 @@ int sp_events_landing(sp_run *run, sp_step_attempt *a, double *theta) {
   /* observed here, kept if the step stands */
   SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
                            run->opt.division.observe_threshold, cells->obs_new));
-  a->observed = 1;
+  *observed = 1;
   for (int k = 0; k < n_cells; ++k) {
     const double m_old = cells->obs[k].mass_core, m_new = cells->obs_new[k].mass_core;
-    if (!sp_division_due(&run->division, &cells->birth[k], a->t, a->t + a->dt, m_old, m_new))
+    if (!sp_division_due(&run->division, &cells->birth[k], t, t + dt, m_old, m_new))
       continue;
-    const double f = sp_division_crossing_fraction(&run->division, &cells->birth[k], a->t,
-                                                   a->t + a->dt, m_old, m_new);
+    const double f = sp_division_crossing_fraction(&run->division, &cells->birth[k], t,
+                                                   t + dt, m_old, m_new);
     /* overshot: past the threshold by more than the tolerance */
     const double over = m_new - sp_division_threshold(&run->division, &cells->birth[k]) *
                                     (1 + SP_MASS_LANDING_TOLERANCE);
@@ -119,7 +128,7 @@ static int split_state(sp_run *run, int parent, const sp_cell_obs *parent_obs,
  * cell, the split state on it, the registry entries of both daughters, a
  * row of divisions.csv.
  */
-static int divide_cell(sp_run *run, int parent) {
+static int divide_cell(sp_run *run, int parent, sp_division_record *record) {
   const int n = run->layout->n_cells, child = n;
   sp_layout *new_layout = NULL;
   SP_CALL(layout_with_child(run, parent, &new_layout));
@@ -148,7 +157,11 @@ static int divide_cell(sp_run *run, int parent) {
   double angle = atan2(dy, dx);
   if (angle <= -M_PI / 2) angle += M_PI;
   if (angle > M_PI / 2) angle -= M_PI;
-  return sp_monitor_division(run, parent, child, angle, parent_obs.mass);
+  *record = (sp_division_record){.parent = parent, .child = child, .angle = angle,
+                                 .parent_mass = parent_obs.mass,
+                                 .mass_a = cells->obs[parent].mass,
+                                 .mass_b = cells->obs[child].mass};
+  return SP_OK;
 }
 
 /** After the step from @p t_old: divide every cell whose criterion was
@@ -169,20 +182,23 @@ static int divide_due_cells(sp_run *run, double t_old, int *n_divided) {
       cells->division_skipped[k] = 1;
       continue;
     }
-    SP_CALL(divide_cell(run, k));
+    sp_division_record record; /* (the registry grows in the division) */
+    SP_CALL(divide_cell(run, k, &record));
+    run->cells.divisions[*n_divided] = record;
     ++*n_divided;
   }
   return SP_OK;
 }
 
-int sp_events_after_step(sp_run *run, const sp_step_attempt *a, sp_step_events *ev) {
+int sp_events_after_step(sp_run *run, double t_old, sp_step_events *ev) {
   *ev = (sp_step_events){0};
-  SP_CALL(divide_due_cells(run, a->t, &ev->n_divided));
+  SP_CALL(divide_due_cells(run, t_old, &ev->n_divided));
+  ev->divisions = run->cells.divisions;
   int outgrown = 0; /* a cell reaches its support's edge */
   if (run->support && !ev->n_divided)
     SP_CALL(sp_support_needs_update(run->support, run->layout, run->state, &outgrown));
   if (run->support && (ev->n_divided || outgrown)) SP_CALL(update_supports(run, ev));
-  if (ev->n_divided) sp_dt_restart(&run->dtc, sp_step_first_dt(run)); /* algorithm 2, or a new first step */
+  if (ev->n_divided) sp_dt_restart(&run->dtc, sp_events_first_dt(run)); /* algorithm 2, or a new first step */
   if (run->opt.terms.source_rate > 0) {
     sp_registry *cells = &run->cells;
     for (int k = 0; k < run->layout->n_cells; ++k) cells->core_mass[k] = cells->obs[k].mass_core;

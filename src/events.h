@@ -11,7 +11,6 @@
 
 #include "run_state.h"
 #include "softpack_solver.h"
-#include "step.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -26,6 +25,7 @@ extern "C" {
 /** What the events after a step did (the monitor reports it). */
 typedef struct {
   int n_divided;         /**< divisions */
+  const sp_division_record *divisions; /**< n_divided of them (the run's scratch) */
   int support_changed;   /**< the local supports were rebuilt */
   double t_supports;     /**< seconds rebuilding them */
   double mass_correction; /**< the largest relative mass change it restored */
@@ -40,21 +40,27 @@ typedef struct {
  *         next age division. */
 double sp_events_next(const sp_run *run, double t);
 
+/** @brief The first dt from the run's state (a run's start, after a
+ *         division): the convexity bound (sp_scheme_first_dt), at most
+ *         time.dt and time.dt_max, at least time.dt_min. */
+double sp_events_first_dt(const sp_run *run);
+
 /** @brief 1 if @p t is a multiple of output.interval (to round-off). */
 int sp_events_on_output_time(const sp_run *run, double t);
 
 /** @brief Adaptive control, mass criterion, N < N_max: the observables of
- *         the attempt's end (into run->cells.obs_new, a->observed = 1) and
- *         the fraction @p theta of the attempt at which the first mass
- *         division due in it was reached when it overshot by more than
- *         SP_MASS_LANDING_TOLERANCE; 1 otherwise. */
-int sp_events_landing(sp_run *run, sp_step_attempt *a, double *theta);
+ *         the end of the step from @p t of @p dt (the run's state; into
+ *         run->cells.obs_new, *observed = 1) and the fraction @p theta of
+ *         the step at which the first mass division due in it was reached
+ *         when it overshot by more than SP_MASS_LANDING_TOLERANCE; 1
+ *         otherwise. */
+int sp_events_landing(sp_run *run, double t, double dt, int *observed, double *theta);
 
-/** @brief After the accepted step @p a (sp_step_complete'd): every cell
+/** @brief After the accepted step from @p t_old (completed): every cell
  *         whose criterion was crossed divides, the supports follow the
  *         cells, the controller restarts after divisions, the source
  *         switches. Collective. */
-int sp_events_after_step(sp_run *run, const sp_step_attempt *a, sp_step_events *ev);
+int sp_events_after_step(sp_run *run, double t_old, sp_step_events *ev);
 
 #ifdef __cplusplus
 }

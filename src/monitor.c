@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "agree.h"
@@ -16,26 +15,10 @@
 #include "output.h"
 #include "partition.h"
 #include "render.h"
-#include "run.h"
+#include "run_energy.h"
+#include "wall_clock.h"
 #include "shape.h"
 #include "solver_status.h"
-
-double sp_wall_clock(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-double sp_energy_fields(const sp_energy_parts *p) {
-  return p->bulk + p->gradient + p->repulsion + p->buffer;
-}
-
-int sp_run_energy(sp_run *run, sp_energy_parts *parts) {
-  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* a collective follows */
-  const int status = sp_solver_energy(run->solver, &run->opt.model, run->state, parts);
-  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "energy");
-  return SP_OK;
-}
 
 /** Grow a double array of *n entries by one, appending @p x. */
 static int append(double **array, int *n, double x) {
@@ -210,12 +193,18 @@ int sp_monitor_attempt(sp_run *run, const sp_step_attempt *a, int rc) {
                       p->dt_min, a->why, run->t, rc_out == SP_OK ? "" : " (failed: see above)");
 }
 
-int sp_monitor_division(sp_run *run, int parent, int child, double angle, double parent_mass) {
+/** The divisions of the step: their rows of divisions.csv, their times on
+ *  energy.png. */
+static int record_divisions(sp_run *run, const sp_step_events *ev) {
   sp_monitor *mon = &run->mon;
-  SP_CALL(append(&mon->division_t, &mon->n_divisions, run->t));
-  if (run->rank != 0) return SP_OK;
-  return sp_output_division(mon->output, run->t, run->step, parent, child, angle, parent_mass,
-                            run->cells.obs[parent].mass, run->cells.obs[child].mass);
+  for (int i = 0; i < ev->n_divided; ++i) {
+    const sp_division_record *d = &ev->divisions[i];
+    SP_CALL(append(&mon->division_t, &mon->n_divisions, run->t));
+    if (run->rank == 0)
+      SP_CALL(sp_output_division(mon->output, run->t, run->step, d->parent, d->child, d->angle,
+                                 d->parent_mass, d->mass_a, d->mass_b));
+  }
+  return SP_OK;
 }
 
 /** The counters and costs of the accepted step @p a and its events. */
@@ -251,10 +240,11 @@ static void count_step(sp_run *run, const sp_step_attempt *a, const sp_step_even
     costs->step = costs->assembly = costs->factorisation = costs->solves = costs->supports = 0;
 }
 
-/** Set by sp_run_request_stop (a signal handler): checkpoint and stop. */
+/** Set by sp_monitor_request_stop (from a signal handler, through
+ *  sp_run_request_stop): checkpoint and stop. */
 static volatile sig_atomic_t stop_requested;
 
-void sp_run_request_stop(void) { stop_requested = 1; }
+void sp_monitor_request_stop(void) { stop_requested = 1; }
 
 void sp_monitor_clear_stop(void) { stop_requested = 0; }
 
@@ -312,6 +302,7 @@ static int call_back(sp_run *run, const sp_step_attempt *a, int failed, int ends
 int sp_monitor_step(sp_run *run, const sp_step_attempt *a, const sp_step_events *ev, int *stop) {
   sp_monitor *mon = &run->mon;
   *stop = 0;
+  SP_CALL(record_divisions(run, ev));
   count_step(run, a, ev);
   const int failed = mon->costs.failed_attempts;
   /* the state is the one the support change left, if there was one */

@@ -5,7 +5,9 @@
  *        snapshots and pictures, the failure lines of rejected attempts,
  *        the costs of each step (energy.csv's columns) summed once into
  *        the run's summary, the user's step callback, and checkpoints
- *        (output.checkpoint_*, or a stop a signal asked for).
+ *        (output.checkpoint_*, or a stop a signal asked for). It sits
+ *        above the step and the events and reports what they did
+ *        (sp_step_attempt, sp_step_events).
  */
 #ifndef SP_MONITOR_H
 #define SP_MONITOR_H
@@ -18,15 +20,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/** @brief Seconds on a monotonic clock. */
-double sp_wall_clock(void);
-
-/** @brief The sum of the field energy's parts (without the shape term). */
-double sp_energy_fields(const sp_energy_parts *parts);
-
-/** @brief The field energy of the run's state (collective: agreed first). */
-int sp_run_energy(sp_run *run, sp_energy_parts *parts);
 
 /** @brief Open the output directory (rank 0): a new one, or for a run
  *         continued from a checkpoint the logs cut back to its step. */
@@ -42,12 +35,8 @@ int sp_monitor_begin(sp_run *run);
  *         SP_ERR_SOLVER returned. */
 int sp_monitor_attempt(sp_run *run, const sp_step_attempt *a, int rc);
 
-/** @brief A division of @p parent into @p parent and @p child (after the
- *         layout change): its row of divisions.csv and its time on
- *         energy.png. @p parent_mass: the parent's mass before the cut. */
-int sp_monitor_division(sp_run *run, int parent, int child, double angle, double parent_mass);
-
-/** @brief After an accepted step and its events: the counters, the energy
+/** @brief After an accepted step and its events: the divisions' rows, the
+ *         counters, the energy
  *         and cells rows, the callback (*stop = 1 if it asks to stop on any
  *         rank), the snapshot when due, a checkpoint when due (*stop = 1 if
  *         a signal asked for one). Collective. */
@@ -59,7 +48,11 @@ void sp_monitor_end(sp_run *run);
 /** @brief Free what the monitor holds (not the summary: the caller's). */
 void sp_monitor_free(sp_monitor *mon);
 
-/** @brief Forget an earlier sp_run_request_stop (run.h): a new run starts. */
+/** @brief Ask for a checkpoint at the end of the step in progress and a
+ *  stop (async-signal-safe; run.h's sp_run_request_stop calls it). */
+void sp_monitor_request_stop(void);
+
+/** @brief Forget an earlier request: a new run starts. */
 void sp_monitor_clear_stop(void);
 
 #ifdef __cplusplus

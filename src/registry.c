@@ -24,6 +24,7 @@ int sp_registry_resize(sp_registry *reg, int n) {
   SP_CALL(resize_array((void **)&reg->obs_new, sizeof *reg->obs_new, n_old, n));
   SP_CALL(resize_array((void **)&reg->core_mass_old, sizeof *reg->core_mass_old, n_old, n));
   SP_CALL(resize_array((void **)&reg->core_mass, sizeof *reg->core_mass, n_old, n));
+  SP_CALL(resize_array((void **)&reg->divisions, sizeof *reg->divisions, n_old, n));
   SP_CALL(resize_array((void **)&reg->shape, sizeof *reg->shape, n_old, n));
   reg->n = n;
   return SP_OK;
@@ -39,5 +40,6 @@ void sp_registry_free(sp_registry *reg) {
   free(reg->core_mass_old);
   free(reg->core_mass);
   free(reg->shape);
+  free(reg->divisions);
   *reg = (sp_registry){0};
 }

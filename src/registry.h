@@ -34,6 +34,7 @@ typedef struct {
   double *core_mass_old;  /**< the core masses before the step */
   double *core_mass;      /**< the core masses after it (the source switch) */
   sp_shape_coef *shape;   /**< the step's shape coefficients */
+  sp_division_record *divisions; /**< the step's divisions (one a cell at most) */
 } sp_registry;
 
 /** @brief Size @p reg for @p n cells: entries kept up to min(old, n), the

@@ -6,6 +6,7 @@
 #include "agree.h"
 #include "checkpoint.h"
 #include "initial.h"
+#include "monitor.h"
 #include "scene.h"
 #include "stepper.h"
 
@@ -103,3 +104,5 @@ int sp_run_file_restart(const char *path, int n_set, const char *const *set,
   free(text);
   return rc;
 }
+
+void sp_run_request_stop(void) { sp_monitor_request_stop(); }

@@ -140,30 +140,40 @@ static int cut_to_supports(sp_run *run, const sp_scene *scene) {
                           run->cells.obs);
 }
 
-/** sp_run_setup after the agreement communicator: its errors are not
- *  agreed yet. */
-static int setup(sp_run *run, const sp_scene *scene, MPI_Comm comm, const sp_run_start *start) {
+/** The mesh, the solver and the initial cells on the full layout, in RCB
+ *  numbering, with the registry of a new run; from a checkpoint without
+ *  cells of the scene's, one placeholder cell (*n: the checkpoint's cells). */
+static int initial_run(sp_run *run, const sp_scene *scene, MPI_Comm comm,
+                       const sp_run_start *start, int *n) {
   SP_MPI_CALL(MPI_Comm_rank(run->agree_comm, &run->rank));
   SP_MPI_CALL(MPI_Comm_size(run->agree_comm, &run->n_ranks));
   SP_CALL(sp_mesh_from_scene(scene, &run->mesh));
   /* The initial cells: the scene's disks or a file's (initial.h). A
-   * checkpoint's replace them below; a scene without cells (initial.from a
+   * checkpoint's replace them later; a scene without cells (initial.from a
    * checkpoint) has one placeholder cell until then. */
   const int placeholder = start && start->checkpoint && scene->n_cells == 0;
-  int n = 1;
-  if (!placeholder) SP_CALL(sp_initial_cell_count(scene, &n));
-  SP_CALL(sp_layout_create_full(run->mesh->n_nodes, n, &run->layout));
+  *n = 1;
+  if (!placeholder) SP_CALL(sp_initial_cell_count(scene, n));
+  SP_CALL(sp_layout_create_full(run->mesh->n_nodes, *n, &run->layout));
   SP_CALL(sp_fault_check(SP_FAULT_SETUP, run->rank));
   SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* creating the solver is collective */
   const int status = sp_solver_create(comm, &run->opt.solver, &run->solver);
   if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "solver");
   SP_ALLOC(run->state, 2 * (size_t)run->layout->n_pairs);
-  SP_CALL(sp_registry_resize(&run->cells, n));
+  SP_CALL(sp_registry_resize(&run->cells, *n));
   if (!placeholder) SP_CALL(sp_initial_state(scene, run->mesh, run->layout, run->state));
   SP_CALL(renumber_rcb(run));
-  if (placeholder) /* what decides on local supports: the checkpoint's cells */
-    sp_checkpoint_cells(start->checkpoint, &n, &run->n_max);
-  else SP_CALL(new_registry(run, &scene->division));
+  if (!placeholder) return new_registry(run, &scene->division);
+  /* what decides on local supports: the checkpoint's cells */
+  sp_checkpoint_cells(start->checkpoint, n, &run->n_max);
+  return SP_OK;
+}
+
+/** sp_run_setup after the agreement communicator: its errors are not
+ *  agreed yet. */
+static int setup(sp_run *run, const sp_scene *scene, MPI_Comm comm, const sp_run_start *start) {
+  int n;
+  SP_CALL(initial_run(run, scene, comm, start, &n));
   /* use_initial_mass: the first initial cell's birth mass (the same for a
    * run continued from a checkpoint, whose scene has the same cells) */
   double reference_mass = run->cells.birth[0].birth_mass;

@@ -1,7 +1,7 @@
 /**
  * @file run_setup.h
  * @brief How a run is set up from its scene, in one function shared by
- *        everything that starts from a scene: the run (stepper.c),
+ *        everything that starts from a scene: the run (stepper.h),
  *        `softpack check-jacobian` (checkjac.c), the benchmarks and the
  *        tests' scene fixture. What they see is what a run steps on: the
  *        same layout, node numbering and local supports. The scene is

@@ -10,26 +10,19 @@
 #include "error.h"
 #include "events.h"
 #include "fault.h"
-#include "monitor.h"
 #include "shape.h"
 #include "solver_status.h"
 #include "source.h"
 #include "time_scheme.h"
+#include "wall_clock.h"
 
 /** solver.predictor linear: the last increment is scaled by dt / dt_last,
  *  at most this much (algorithm 2's ramp multiplies dt by up to 64). */
 #define SP_PREDICTOR_MAX_RATIO 2.0
 
-double sp_step_first_dt(const sp_run *run) {
-  const sp_dt_params *p = &run->opt.time.dt;
-  const double dt =
-      sp_scheme_first_dt(run->layout, run->state, &run->opt.model, fmin(p->dt, p->dt_max));
-  return fmax(dt, p->dt_min);
-}
-
 void sp_step_begin(sp_run *run) {
   if (run->restarted) sp_dt_resume(&run->dtc, &run->opt.time.dt); /* state: the checkpoint's */
-  else sp_dt_init(&run->dtc, &run->opt.time.dt, sp_step_first_dt(run));
+  else sp_dt_init(&run->dtc, &run->opt.time.dt, sp_events_first_dt(run));
 }
 
 int sp_step_run_ends(const sp_run *run) {
@@ -103,7 +96,7 @@ static int judge(sp_run *run, sp_scheme_kind kind, int solved, sp_step_attempt *
     return SP_OK;
   }
   double theta;
-  SP_CALL(sp_events_landing(run, a, &theta));
+  SP_CALL(sp_events_landing(run, a->t, a->dt, &a->observed, &theta));
   if (theta < 1) { /* land on the crossing: redo the step shorter */
     sp_dt_land(&run->dtc, theta * a->dt);
     a->why = "a cell's mass passed its division mass inside the step (landing on it)";

@@ -69,11 +69,6 @@ int sp_step_complete(sp_run *run, const sp_step_attempt *a);
  *         run continued from a checkpoint): before the first attempt. */
 void sp_step_begin(sp_run *run);
 
-/** @brief The first dt from the run's state: the convexity bound
- *         (sp_scheme_first_dt), at most time.dt and time.dt_max, at least
- *         time.dt_min. */
-double sp_step_first_dt(const sp_run *run);
-
 /** @brief 1 once the run has reached t_end or time.max_steps. */
 int sp_step_run_ends(const sp_run *run);
 

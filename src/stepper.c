@@ -6,6 +6,7 @@
 #include "events.h"
 #include "monitor.h"
 #include "step.h"
+#include "wall_clock.h"
 
 /** The time loop: attempts until one is accepted, then its completion, its
  *  events and its report, until t_end, time.max_steps or a stop. */
@@ -18,7 +19,7 @@ static int run_steps(sp_run *run) {
     rc = sp_monitor_attempt(run, &a, sp_step_try(run, &a));
     if (rc != SP_OK || a.verdict != SP_STEP_ACCEPTED) continue;
     rc = sp_step_complete(run, &a);
-    if (rc == SP_OK) rc = sp_events_after_step(run, &a, &ev);
+    if (rc == SP_OK) rc = sp_events_after_step(run, a.t, &ev);
     if (rc == SP_OK) rc = sp_monitor_step(run, &a, &ev, &stop);
   }
   sp_monitor_end(run);

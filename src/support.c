@@ -29,6 +29,25 @@ typedef struct {
   int64_t cap;
 } cell_lists;
 
+/** The elements around each node (s->ne_start, s->ne_list). */
+static int node_elements(struct sp_support_s *s) {
+  const sp_mesh *mesh = s->mesh;
+  const int nn = mesh->n_nodes, ne = mesh->n_elems;
+  for (int e = 0; e < ne; ++e)
+    for (int a = 0; a < 4; ++a) ++s->ne_start[mesh->elem[4 * e + a] + 1];
+  for (int i = 0; i < nn; ++i) s->ne_start[i + 1] += s->ne_start[i];
+  int *fill;
+  SP_ALLOC(fill, nn);
+  for (int e = 0; e < ne; ++e) {
+    for (int a = 0; a < 4; ++a) {
+      int n = mesh->elem[4 * e + a];
+      s->ne_list[s->ne_start[n] + fill[n]++] = e;
+    }
+  }
+  free(fill);
+  return SP_OK;
+}
+
 int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_support *out) {
   SP_CHECK(params->margin > 0 && params->band > 0 && params->band < params->margin,
            SP_ERR_INPUT, "layout: need 0 < band (%g) < margin (%g)", params->band,
@@ -47,19 +66,7 @@ int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_s
   SP_ALLOC(s->in_set, nn);
   SP_ALLOC(s->member, nn);
   SP_ALLOC(s->kept, nn);
-  for (int e = 0; e < ne; ++e)
-    for (int a = 0; a < 4; ++a) ++s->ne_start[mesh->elem[4 * e + a] + 1];
-  for (int i = 0; i < nn; ++i) s->ne_start[i + 1] += s->ne_start[i];
-  int *fill;
-  SP_ALLOC(fill, nn);
-  for (int e = 0; e < ne; ++e) {
-    for (int a = 0; a < 4; ++a) {
-      int n = mesh->elem[4 * e + a];
-      s->ne_list[s->ne_start[n] + fill[n]++] = e;
-    }
-  }
-  free(fill);
-  return SP_OK;
+  return node_elements(s);
 }
 
 void sp_support_destroy(sp_support *s) {
@@ -303,13 +310,60 @@ static double buffer_share(sp_support s, int i) {
   return (double)buffer / n;
 }
 
+/** Per cell, the means of c and mu over the nodes on the edge of its
+ *  support (@p n_edge: their number; the arrays zeroed by the caller). */
+static void edge_means(sp_support s, const sp_layout *layout, const double *state,
+                       double *edge_c, double *edge_mu, int *n_edge) {
+  const int nn = s->mesh->n_nodes, nc = layout->n_cells;
+  for (int i = 0; i < nn; ++i)
+    for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p) {
+      const int k = layout->pair_cell[p];
+      if (!on_edge(s, layout, k, i)) continue;
+      edge_c[k] += state[2 * p];
+      edge_mu[k] += state[2 * p + 1];
+      ++n_edge[k];
+    }
+  for (int k = 0; k < nc; ++k)
+    if (n_edge[k]) {
+      edge_c[k] /= n_edge[k];
+      edge_mu[k] /= n_edge[k];
+    }
+}
+
+/** New nodes continue the far field: the old edge's mean c_e where the
+ *  cell is alone. Where a neighbour or the buffer ring is, the far field
+ *  is held down: for small c, mu = c (2 alpha + 2 lambda sum_{l != k}
+ *  c_l^2 + 2 lambda_b b) (b: the node's share of buffer elements), so at
+ *  the free far field's chemical potential 2 alpha c_e the node gets
+ *  c_e 2 alpha / (that stiffness) (~ c_e / 25 inside a neighbour). The
+ *  edge's c_e copied into a neighbour would raise the repulsion energy
+ *  at first order. mu: the edge's mean. */
+static void continue_far_field(sp_support s, const sp_layout *layout, const double *state,
+                               const sp_layout *to, double *next, const double *edge_c,
+                               const double *edge_mu) {
+  const int nn = s->mesh->n_nodes;
+  for (int i = 0; i < nn; ++i)
+    for (int q = to->node_start[i]; q < to->node_start[i + 1]; ++q) {
+      const int k = to->pair_cell[q];
+      if (sp_layout_pair(layout, k, i) >= 0) continue;
+      double others = 0; /* sum over l != k of c_l^2 at node i (old state) */
+      for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p)
+        if (layout->pair_cell[p] != k) others += state[2 * p] * state[2 * p];
+      const double free_stiffness = 2 * s->params.alpha;
+      const double stiffness = free_stiffness + 2 * s->params.lambda * others +
+                               2 * s->params.lambda_b * buffer_share(s, i);
+      next[2 * q] = stiffness > 0 ? edge_c[k] * free_stiffness / stiffness : edge_c[k];
+      next[2 * q + 1] = edge_mu[k];
+    }
+}
+
 /** The interior of a cell, where support changes restore its mass. */
 #define SP_SUPPORT_INTERIOR 0.5
 
 int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *state,
                        const unsigned char *may_shrink, sp_layout **new_layout,
                        double **new_state, double *mass_correction, double *mass_dropped) {
-  const int nn = s->mesh->n_nodes, nc = layout->n_cells;
+  const int nc = layout->n_cells;
   *new_layout = NULL;
   *new_state = NULL;
   *mass_correction = 0;
@@ -333,40 +387,10 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   if (!acc || !n_edge || !w) rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
   double *edge_c = acc, *edge_mu = acc + nc, *w_interior = acc + 2 * (size_t)nc,
          *w_all = acc + 3 * (size_t)nc;
-  for (int i = 0; i < nn && rc == SP_OK; ++i)
-    for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p) {
-      const int k = layout->pair_cell[p];
-      if (!on_edge(s, layout, k, i)) continue;
-      edge_c[k] += state[2 * p];
-      edge_mu[k] += state[2 * p + 1];
-      ++n_edge[k];
-    }
-  for (int k = 0; k < nc && rc == SP_OK; ++k)
-    if (n_edge[k]) {
-      edge_c[k] /= n_edge[k];
-      edge_mu[k] /= n_edge[k];
-    }
-  /* New nodes continue the far field: the old edge's mean c_e where the
-   * cell is alone. Where a neighbour or the buffer ring is, the far field
-   * is held down: for small c, mu = c (2 alpha + 2 lambda sum_{l != k}
-   * c_l^2 + 2 lambda_b b) (b: the node's share of buffer elements), so at
-   * the free far field's chemical potential 2 alpha c_e the node gets
-   * c_e 2 alpha / (that stiffness) (~ c_e / 25 inside a neighbour). The
-   * edge's c_e copied into a neighbour would raise the repulsion energy
-   * at first order. mu: the edge's mean. */
-  for (int i = 0; i < nn && rc == SP_OK; ++i)
-    for (int q = to->node_start[i]; q < to->node_start[i + 1]; ++q) {
-      const int k = to->pair_cell[q];
-      if (sp_layout_pair(layout, k, i) >= 0) continue;
-      double others = 0; /* sum over l != k of c_l^2 at node i (old state) */
-      for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p)
-        if (layout->pair_cell[p] != k) others += state[2 * p] * state[2 * p];
-      const double free_stiffness = 2 * s->params.alpha;
-      const double stiffness = free_stiffness + 2 * s->params.lambda * others +
-                               2 * s->params.lambda_b * buffer_share(s, i);
-      next[2 * q] = stiffness > 0 ? edge_c[k] * free_stiffness / stiffness : edge_c[k];
-      next[2 * q + 1] = edge_mu[k];
-    }
+  if (rc == SP_OK) {
+    edge_means(s, layout, state, edge_c, edge_mu, n_edge);
+    continue_far_field(s, layout, state, to, next, edge_c, edge_mu);
+  }
   if (rc == SP_OK) rc = sp_cells_observe(s->mesh, layout, state, 0.0, before);
   if (rc == SP_OK) rc = sp_cells_observe(s->mesh, to, next, 0.0, after);
   /* A shift of c_k by d on a set of nodes changes the mass by d x (their

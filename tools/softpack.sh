@@ -8,6 +8,8 @@
 #                                run the fast tests (ctest -L fast)
 #   tools/softpack.sh fuzz [SECONDS]   libFuzzer on the scene reader (default 600 s)
 #   (these three: docs/robustness.md)
+#   tools/softpack.sh complexity   clang-tidy's cognitive complexity of src/'s
+#                                  functions, against the limits of docs/design.md
 # Everything comes from Debian's archive; nothing is downloaded otherwise.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -69,6 +71,10 @@ case "${1:-}" in
     install_missing
     build
     cd build && ctest --output-on-failure -j 2
+    ;;
+  complexity)
+    install_missing clang-tidy
+    exec tools/complexity.sh . "${2:-15}"
     ;;
   valgrind)
     install_missing valgrind

@@ -1,0 +1,15 @@
+#include "run_energy.h"
+
+#include "agree.h"
+#include "solver_status.h"
+
+double sp_energy_fields(const sp_energy_parts *p) {
+  return p->bulk + p->gradient + p->repulsion + p->buffer;
+}
+
+int sp_run_energy(sp_run *run, sp_energy_parts *parts) {
+  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* a collective follows */
+  const int status = sp_solver_energy(run->solver, &run->opt.model, run->state, parts);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "energy");
+  return SP_OK;
+}
