@@ -239,9 +239,13 @@ static int write_state(hid_t f, const sp_run *run) {
   for (const char *g = "/layout\0/history\0/cells\0/controller\0/summary\0/output\0"; *g;
        g += strlen(g) + 1)
     bad |= make_group(f, g);
-  const int n_fields_now = run->mon.output ? sp_output_fields_list(run->mon.output, &(const sp_output_field *){NULL}) : 0;
-  const int header[HEADER_INTS] = {run->step, run->n_max, run->n_ranks, ly->n_cells,
-                                   run->hist.n, run->mon.n_energy, run->mon.n_divisions, n_fields_now};
+  const int n_fields_now =
+      run->mon.output
+          ? sp_output_fields_list(run->mon.output, &(const sp_output_field *){NULL})
+          : 0;
+  const int header[HEADER_INTS] = {run->step,         run->n_max,          run->n_ranks,
+                                   ly->n_cells,       run->hist.n,         run->mon.n_energy,
+                                   run->mon.n_divisions, n_fields_now};
   const double header_t[HEADER_DOUBLES] = {run->t, run->hist.dt[0], run->hist.dt[1]};
   bad |= put_array(f, "/header", H5T_NATIVE_INT, header, HEADER_INTS);
   bad |= put_array(f, "/header_t", H5T_NATIVE_DOUBLE, header_t, HEADER_DOUBLES);
@@ -275,7 +279,8 @@ static int write_state(hid_t f, const sp_run *run) {
   bad |= put_array(f, "/cells/divided_now", H5T_NATIVE_UCHAR, run->cells.divided_now, nc);
   bad |= put_members(f, "/controller", &run->dtc, controller_members, N_OF(controller_members));
   bad |= put_members(f, "/summary", run->mon.sum, summary_members, N_OF(summary_members));
-  bad |= put_array(f, "/output/energy_t", H5T_NATIVE_DOUBLE, run->mon.energy_t, run->mon.n_energy);
+  bad |= put_array(f, "/output/energy_t", H5T_NATIVE_DOUBLE, run->mon.energy_t,
+                   run->mon.n_energy);
   bad |= put_array(f, "/output/energy_total", H5T_NATIVE_DOUBLE, run->mon.energy_total,
                    run->mon.n_energy);
   bad |= put_array(f, "/output/division_t", H5T_NATIVE_DOUBLE, run->mon.division_t,

@@ -198,7 +198,8 @@ int sp_events_after_step(sp_run *run, double t_old, sp_step_events *ev) {
   if (run->support && !ev->n_divided)
     SP_CALL(sp_support_needs_update(run->support, run->layout, run->state, &outgrown));
   if (run->support && (ev->n_divided || outgrown)) SP_CALL(update_supports(run, ev));
-  if (ev->n_divided) sp_dt_restart(&run->dtc, sp_events_first_dt(run)); /* algorithm 2, or a new first step */
+  if (ev->n_divided) /* algorithm 2, or a new first step */
+    sp_dt_restart(&run->dtc, sp_events_first_dt(run));
   if (run->opt.terms.source_rate > 0) {
     sp_registry *cells = &run->cells;
     for (int k = 0; k < run->layout->n_cells; ++k) cells->core_mass[k] = cells->obs[k].mass_core;

@@ -118,24 +118,30 @@ static int differences(const sp_run *a, const sp_run *b, int say) {
     DIFF(!memcmp(a->hist.past[i], b->hist.past[i], sizeof(double) * nv), "history past");
   DIFF(b->step == a->step && b->t == a->t && b->n_max == a->n_max, "step, t, n_max");
   for (int k = 0; k < la->n_cells; ++k) {
-    DIFF(b->cells.birth[k].birth_time == a->cells.birth[k].birth_time &&
-         b->cells.birth[k].birth_mass == a->cells.birth[k].birth_mass &&
-         b->cells.birth[k].Iref[0] == a->cells.birth[k].Iref[0] && b->cells.birth[k].Iref[1] == a->cells.birth[k].Iref[1] &&
-         b->cells.birth[k].generation == a->cells.birth[k].generation, "birth");
-    DIFF(b->cells.source_on[k] == a->cells.source_on[k] && b->cells.division_skipped[k] == a->cells.division_skipped[k] &&
-         b->cells.divided_now[k] == a->cells.divided_now[k], "registry");
+    const sp_cell_birth *ba = &a->cells.birth[k], *bb = &b->cells.birth[k];
+    DIFF(bb->birth_time == ba->birth_time && bb->birth_mass == ba->birth_mass &&
+             bb->Iref[0] == ba->Iref[0] && bb->Iref[1] == ba->Iref[1] &&
+             bb->generation == ba->generation,
+         "birth");
+    DIFF(b->cells.source_on[k] == a->cells.source_on[k] &&
+             b->cells.division_skipped[k] == a->cells.division_skipped[k] &&
+             b->cells.divided_now[k] == a->cells.divided_now[k],
+         "registry");
   }
   sp_dt_control da = a->dtc, db = b->dtc;
   db.p = da.p; /* the parameters come from the scene */
   DIFF(!memcmp(&da, &db, sizeof da), "the controller");
   DIFF(!memcmp(a->mon.sum, b->mon.sum, sizeof *a->mon.sum), "the summary");
-  DIFF(b->mon.n_energy == a->mon.n_energy && b->mon.n_divisions == a->mon.n_divisions, "energy history sizes");
+  DIFF(b->mon.n_energy == a->mon.n_energy && b->mon.n_divisions == a->mon.n_divisions,
+       "energy history sizes");
   if (b->mon.n_energy == a->mon.n_energy) {
-    DIFF(!memcmp(a->mon.energy_t, b->mon.energy_t, sizeof(double) * a->mon.n_energy), "energy_t");
-    DIFF(!memcmp(a->mon.energy_total, b->mon.energy_total, sizeof(double) * a->mon.n_energy), "energy_total");
+    const size_t bytes = sizeof(double) * a->mon.n_energy;
+    DIFF(!memcmp(a->mon.energy_t, b->mon.energy_t, bytes), "energy_t");
+    DIFF(!memcmp(a->mon.energy_total, b->mon.energy_total, bytes), "energy_total");
   }
   if (b->mon.n_divisions == a->mon.n_divisions)
-    DIFF(!memcmp(a->mon.division_t, b->mon.division_t, sizeof(double) * a->mon.n_divisions), "division_t");
+    DIFF(!memcmp(a->mon.division_t, b->mon.division_t, sizeof(double) * a->mon.n_divisions),
+         "division_t");
 #undef DIFF
   return n;
 }
@@ -170,7 +176,8 @@ static void round_trip(const sp_scene *scene) {
   const char *const *set;
   const char *text = sp_checkpoint_scene(ck, &len, &n_set, &set);
   CHECK(len == a->scene_text.len && memcmp(text, a->scene_text.text, len) == 0, "scene text");
-  CHECK(n_set == 2 && strcmp(set[0], a->scene_text.set[0]) == 0 && strcmp(set[1], a->scene_text.set[1]) == 0,
+  CHECK(n_set == 2 && strcmp(set[0], a->scene_text.set[0]) == 0 &&
+            strcmp(set[1], a->scene_text.set[1]) == 0,
         "overrides");
   sp_checkpoint_close(&ck);
   CHECK_OK(restore(path, scene, &sb));

@@ -34,9 +34,19 @@
   "  - {x: 0.62, y: 0.52, radius: 0.13}\n"                                     \
   "output: {pictures: false}\n"
 
+/** A run of the scene @p text set up and its controller started, as the
+ *  loop starts it. */
 static scene_run *set_up(const char *text, sp_scene **scene) {
   CHECK_OK(sp_scene_load_text("test_step", text, strlen(text), 0, NULL, scene));
-  return scene_run_setup(*scene);
+  scene_run *s = scene_run_setup(*scene);
+  sp_step_begin(&s->run);
+  return s;
+}
+
+static void tear_down(scene_run **s, sp_scene **scene, double *saved_state) {
+  free(saved_state);
+  scene_run_free(s);
+  sp_scene_destroy(scene);
 }
 
 /** What an attempt must leave as it was when it is not accepted. */
@@ -77,7 +87,6 @@ static void newton_failed(void) {
                              " newton_atol: 1e-16, jacobian_reuse: 0}\n",
                         &scene);
   sp_run *run = &s->run;
-  sp_step_begin(run);
   const snapshot before = take(run);
   sp_step_attempt a;
   CHECK_OK(sp_step_try(run, &a));
@@ -87,9 +96,7 @@ static void newton_failed(void) {
   CHECK(!a.give_up && run->dtc.dt_next < a.dt, "the retry: dt %g -> %g, give up %d", a.dt,
         run->dtc.dt_next, a.give_up);
   same_as(run, &before, "Newton failed");
-  free(before.state);
-  scene_run_free(&s);
-  sp_scene_destroy(&scene);
+  tear_down(&s, &scene, before.state);
 }
 
 static void error_too_large(void) {
@@ -99,7 +106,6 @@ static void error_too_large(void) {
                              "solver: {linear: superlu}\n",
                         &scene);
   sp_run *run = &s->run;
-  sp_step_begin(run);
   const double m0 = total_mass(run);
   sp_step_attempt a;
   CHECK_OK(sp_step_try(run, &a));
@@ -115,9 +121,7 @@ static void error_too_large(void) {
         "verdict %d, estimate %g: not rejected", a.verdict, a.err);
   CHECK(run->dtc.dt_next < a.dt, "the retry: dt %g -> %g", a.dt, run->dtc.dt_next);
   same_as(run, &before, "error too large");
-  free(before.state);
-  scene_run_free(&s);
-  sp_scene_destroy(&scene);
+  tear_down(&s, &scene, before.state);
 }
 
 static void landing(void) {
@@ -128,7 +132,6 @@ static void landing(void) {
                              "solver: {linear: superlu}\n",
                         &scene);
   sp_run *run = &s->run;
-  sp_step_begin(run);
   /* accepted steps until one passes the division mass inside it */
   sp_step_attempt a = {0};
   int attempts = 0;
@@ -157,9 +160,7 @@ static void landing(void) {
   CHECK(closest <= SP_MASS_LANDING_TOLERANCE,
         "after the redo no cell is within %g of its division mass (closest %g)",
         SP_MASS_LANDING_TOLERANCE, closest);
-  free(before.state);
-  scene_run_free(&s);
-  sp_scene_destroy(&scene);
+  tear_down(&s, &scene, before.state);
 }
 
 int main(int argc, char **argv) {
