@@ -66,10 +66,7 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   }
   bool applyJacobianInverse(Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
                             NOX::Epetra::Vector &out) override {
-    std::string why;
-    bool ok = s_.solve_linear(in.getEpetraVector(), out.getEpetraVector(), why);
-    if (!ok) s_.last_error = why;
-    return ok;
+    return s_.solve_linear(in.getEpetraVector(), out.getEpetraVector());
   }
   bool applyRightPreconditioning(bool, Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
                                  NOX::Epetra::Vector &out) const override {
@@ -80,7 +77,7 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   void resetScaling(const Teuchos::RCP<NOX::Epetra::Scaling> &) override {}
   bool computeJacobian(const NOX::Epetra::Vector &x) override {
     if (s_.may_reuse_jacobian()) return true;  // keep matrix and factors
-    return i_.computeJacobian(x.getEpetraVector(), *s_.jacobian_matrix);
+    return i_.computeJacobian(x.getEpetraVector(), *s_.jacobian_operator());
   }
   bool createPreconditioner(const NOX::Epetra::Vector &, Teuchos::ParameterList &,
                             bool) const override { return false; }
@@ -91,9 +88,9 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   bool isPreconditionerConstructed() const override { return false; }
   bool hasPreconditioner() const override { return false; }
   Teuchos::RCP<const Epetra_Operator> getJacobianOperator() const override {
-    return s_.jacobian_matrix;
+    return s_.jacobian_operator();
   }
-  Teuchos::RCP<Epetra_Operator> getJacobianOperator() override { return s_.jacobian_matrix; }
+  Teuchos::RCP<Epetra_Operator> getJacobianOperator() override { return s_.jacobian_operator(); }
   Teuchos::RCP<const Epetra_Operator> getGeneratedPrecOperator() const override {
     return Teuchos::null;
   }
@@ -302,7 +299,7 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   const Epetra_CrsGraph &g = assembly_->graph();
   const int n = g.NumMyRows();
   agree_local(comm_, [&] {  // (the gathers below are collective)
-    jacobian_matrix = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
+    jacobian_matrix_ = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
     first_row_ = n > 0 ? g.RowMap().GID(0) : 0;
     for (int i = 0; i < n; ++i)
       if (g.RowMap().GID(i) != first_row_ + i)
@@ -323,7 +320,7 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   // backend that only reads them reads the Jacobian's own storage, and no
   // copy is made.
   rows_in_place_ = P == 1 && !linear_->overwrites_values() &&
-                   jacobian_matrix->StorageOptimized() &&
+                   jacobian_matrix_->StorageOptimized() &&
                    g.ColMap().NumMyElements() == n_global_;
   for (int k = 0; rows_in_place_ && k < g.ColMap().NumMyElements(); ++k)
     rows_in_place_ = g.ColMap().GID(k) == k;
@@ -381,7 +378,7 @@ void Solver::fill_residual(const sp_step_data &d, const Epetra_Vector &x, Epetra
   double t0 = now();
   gather(x, full_);
   assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), F);
-  t_assembly += now() - t0;
+  t_assembly_ += now() - t0;
 }
 
 void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
@@ -390,7 +387,7 @@ void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
   // The element Jacobians take the shape coefficients as constants; their
   // dependence on the moments is the low-rank part (prepare_shape).
   assembly_->jacobian(shape_.data_at(d, *assembly_, full_.data()), full_.data(),
-                      options_.jacobian, *jacobian_matrix);
+                      options_.jacobian, *jacobian_matrix_);
   jacobian_fresh_ = true;
   if (carries()) {
     jac_x_ = full_;
@@ -399,7 +396,7 @@ void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
     if (d.shape) jac_shape_.assign(d.shape, d.shape + assembly_->n_cells());
     else jac_shape_.clear();
   }
-  t_assembly += now() - t0;
+  t_assembly_ += now() - t0;
 }
 
 void Solver::prepare_shape(const sp_step_data &d) {
@@ -408,9 +405,9 @@ void Solver::prepare_shape(const sp_step_data &d) {
 }
 
 bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out, bool transpose) {
-  jacobian_matrix->SetUseTranspose(transpose);
-  const bool ok = jacobian_matrix->Apply(in, out) == 0;
-  jacobian_matrix->SetUseTranspose(false);
+  jacobian_matrix_->SetUseTranspose(transpose);
+  const bool ok = jacobian_matrix_->Apply(in, out) == 0;
+  jacobian_matrix_->SetUseTranspose(false);
   if (!ok) return false;
   linear_->term().add_apply(comm_.Comm(), in.Values(), out.Values(), transpose);
   return true;
@@ -473,7 +470,7 @@ bool Solver::may_reuse_jacobian() const {
 
 bool Solver::factor_jacobian(std::string &why) {
   double t0 = now();
-  const int n = jacobian_matrix->NumMyRows();
+  const int n = jacobian_matrix_->NumMyRows();
   CsrRows A;
   A.n_global = n_global_;
   A.first_row = first_row_;
@@ -481,17 +478,17 @@ bool Solver::factor_jacobian(std::string &why) {
   if (rows_in_place_) {
     int *offsets, *cols;
     double *vals;
-    if (jacobian_matrix->ExtractCrsDataPointers(offsets, cols, vals) != 0)
+    if (jacobian_matrix_->ExtractCrsDataPointers(offsets, cols, vals) != 0)
       throw std::logic_error("the Jacobian's storage is not contiguous");
     A.row_ptr = offsets;
     A.col = cols;
     A.val = vals;
-    A.matrix = jacobian_matrix.get();
+    A.matrix = jacobian_matrix_.get();
   } else {
     for (int i = 0; i < n; ++i) {
       int len;
       double *vals;
-      jacobian_matrix->ExtractMyRowView(i, len, vals);
+      jacobian_matrix_->ExtractMyRowView(i, len, vals);
       for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = vals[csr_from_[k]];
     }
     A.row_ptr = csr_ptr_.data();
@@ -501,7 +498,7 @@ bool Solver::factor_jacobian(std::string &why) {
   linear_->set_rhs_count(1);
   bool ok = linear_->factor(A, !pattern_changed_, why);
   ok = all_agree(comm_.Comm(), ok, why);
-  t_factor += now() - t0;
+  t_factor_ += now() - t0;
   if (!ok) {
     pattern_changed_ = true;  // start the next factorisation from scratch
     return false;
@@ -512,15 +509,20 @@ bool Solver::factor_jacobian(std::string &why) {
   return true;
 }
 
-bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
+bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x) {
+  std::string why;
   const bool fresh = jacobian_fresh_;
-  if (fresh && !factor_jacobian(why)) return false;
+  if (fresh && !factor_jacobian(why)) {
+    linear_failure_ = why;
+    return false;
+  }
   // (the first solve after a factorisation also does the low-rank term's
   // block solve and small factorisation: counted as solve time)
   double t0 = now();
   bool ok = linear_->solve(b.Values(), x.Values(), why);
-  t_solve += now() - t0;
+  t_solve_ += now() - t0;
   if (!ok && fresh) jacobian_fresh_ = true;  // refactor before the next solve
+  if (!ok) linear_failure_ = why;
   return ok;
 }
 
@@ -530,7 +532,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
       (d.update_rtol > 0 && !(d.update_atol > 0)))
     throw input_error("sp_step_data: expected update_atol > 0 with update_rtol > 0, both >= 0");
   report = sp_step_report{};
-  t_assembly = t_factor = t_solve = 0;
+  t_assembly_ = t_factor_ = t_solve_ = 0;
   step_factorisations_ = 0;
   step_norms_.clear();
   const double t_start = now();
@@ -603,15 +605,15 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   // iteration's work but is counted in assembly all the same.
 
   auto solver = NOX::Solver::buildSolver(group, all, params);
-  last_error.clear();
-  // A failed linear solve (applyJacobianInverse false, last_error set):
+  linear_failure_.clear();
+  // A failed linear solve (applyJacobianInverse false, linear_failure_ set):
   // NOX's Newton direction throws; the attempt failed, as a diverging one.
   // Any other NOX error ends the run with what NOX printed.
   StatusType status = Failed;
   try {
     status = solver->solve();
   } catch (...) {
-    if (last_error.empty()) {
+    if (linear_failure_.empty()) {
       std::string text = nox_errors->str();
       while (!text.empty() && std::isspace((unsigned char)text.back())) text.pop_back();
       if (text.empty()) throw;
@@ -623,9 +625,9 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   report.linear_its = linear_->iterations() - linear_its_before;
   report.n_residuals = (int)std::min<size_t>(step_norms_.size(), SP_MAX_NEWTON_HISTORY);
   std::copy(step_norms_.begin(), step_norms_.begin() + report.n_residuals, report.residual_norms);
-  report.t_assembly = t_assembly;
-  report.t_factor = t_factor;
-  report.t_solve = t_solve;
+  report.t_assembly = t_assembly_;
+  report.t_factor = t_factor_;
+  report.t_solve = t_solve_;
   if (status == Converged) {
     const auto &xs = dynamic_cast<const NOX::Epetra::Vector &>(
         solver->getSolutionGroup().getX()).getEpetraVector();
@@ -639,7 +641,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   const double last = report.n_residuals ? report.residual_norms[report.n_residuals - 1] : NAN;
   char ratio[32];
   snprintf(ratio, sizeof ratio, "%g", options_.newton_divergence);
-  report.failure = !last_error.empty() ? SP_NEWTON_LINEAR_FAILED
+  report.failure = !linear_failure_.empty() ? SP_NEWTON_LINEAR_FAILED
                    : !std::isfinite(last) ? SP_NEWTON_NOT_FINITE
                    : !diverged.is_null() && diverged->getStatus() == Failed ? SP_NEWTON_DIVERGED
                    : report.newton_its >= max_its ||
@@ -650,7 +652,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
                              std::to_string(report.factorisations) + " factorisations)";
   std::string why;
   switch (report.failure) {
-    case SP_NEWTON_LINEAR_FAILED: why = last_error; break;
+    case SP_NEWTON_LINEAR_FAILED: why = linear_failure_; break;
     case SP_NEWTON_NOT_FINITE: why = "the residual is not finite"; break;
     case SP_NEWTON_DIVERGED:
       why = "diverged: |F| above " + std::string(ratio) + " x the first |F| after " + counts;
