@@ -1,7 +1,10 @@
 // The object behind the sp_solver handle: an Assembly for the current
 // layout, the Jacobian (a sparse matrix and, with the implicit shape term,
-// a low-rank part beside it), a linear solver for it, and one NOX Newton
-// solve per backward-Euler step.
+// a low-rank part beside it), a linear solver for it, and NOX's Newton
+// solve of each time step's equations. What NOX needs is built ahead of the
+// steps (newton.cpp, Solver::Nox): the parameter list and the status tests
+// once per solver, the group and the NOX solver once per layout; a step
+// only loads its guess and its tolerances into them.
 #ifndef SP_NEWTON_HPP
 #define SP_NEWTON_HPP
 
@@ -24,6 +27,9 @@ namespace sp {
 class Solver {
  public:
   Solver(MPI_Comm comm, const sp_solver_options &options);
+  ~Solver();  // (out of line: Nox is complete only in newton.cpp)
+  Solver(const Solver &) = delete;
+  Solver &operator=(const Solver &) = delete;
 
   void set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout);
   /// Whether the next step may begin on the current factorisation
@@ -73,6 +79,13 @@ class Solver {
   double step_first_norm() const { return step_norms_.empty() ? NAN : step_norms_.front(); }
 
  private:
+  // NOX's side of the solve (newton.cpp): the parameter list and the status
+  // tests, built by the constructor; the group (the Newton iterate and its
+  // F, J, update) and the NOX solver over it, built by set_problem for each
+  // layout.
+  struct Nox;
+  // Builds NOX's group and solver on the current layout's map.
+  void build_nox_solve();
   void require_problem() const;
   // A step's implicit shape term: its coefficients (shape_) and its
   // Jacobian part, handed to the linear solver.
@@ -93,6 +106,7 @@ class Solver {
   std::unique_ptr<Assembly> assembly_;
   // The backend of solver.linear inside the low-rank (Woodbury) wrapper.
   std::unique_ptr<LowRankSolver> linear_;
+  std::unique_ptr<Nox> nox_;
   std::vector<int> csr_ptr_, csr_col_;  // this rank's rows: pattern, global columns (sorted)
   std::vector<int> csr_from_;           // position of each entry in its Epetra row
   int first_row_ = 0, n_global_ = 0;    // the rows are first_row_ .. + n_rows - 1
