@@ -33,23 +33,40 @@ double now() {
   return duration<double>(steady_clock::now().time_since_epoch()).count();
 }
 
-// NOX's callbacks: residual and Jacobian of one step.
+// NOX's callbacks: residual and Jacobian of the current step's equations.
+// Built once per layout with the group; Solver::step points it at its
+// sp_step_data for the length of the step (Scope).
 class StepInterface : public NOX::Epetra::Interface::Required,
                       public NOX::Epetra::Interface::Jacobian {
  public:
-  StepInterface(Solver &s, const sp_step_data &d) : s_(s), d_(d) {}
+  explicit StepInterface(Solver &s) : s_(s) {}
   bool computeF(const Epetra_Vector &x, Epetra_Vector &F, FillType) override {
-    s_.fill_residual(d_, x, F);
+    s_.fill_residual(data(), x, F);
     return true;
   }
   bool computeJacobian(const Epetra_Vector &x, Epetra_Operator &) override {
-    s_.fill_jacobian(d_, x);
+    s_.fill_jacobian(data(), x);
     return true;
   }
+  // Points the callbacks at d until the scope ends.
+  class Scope {
+   public:
+    Scope(StepInterface &i, const sp_step_data &d) : i_(i) { i_.d_ = &d; }
+    ~Scope() { i_.d_ = nullptr; }
+    Scope(const Scope &) = delete;
+    Scope &operator=(const Scope &) = delete;
+
+   private:
+    StepInterface &i_;
+  };
 
  private:
+  const sp_step_data &data() const {
+    if (!d_) throw std::logic_error("NOX evaluated the step equations outside a step");
+    return *d_;
+  }
   Solver &s_;
-  const sp_step_data &d_;
+  const sp_step_data *d_ = nullptr;
 };
 
 // NOX's hook for a direct solver: J is assembled by StepInterface and
@@ -66,10 +83,7 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   }
   bool applyJacobianInverse(Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
                             NOX::Epetra::Vector &out) override {
-    std::string why;
-    bool ok = s_.solve_linear(in.getEpetraVector(), out.getEpetraVector(), why);
-    if (!ok) s_.last_error = why;
-    return ok;
+    return s_.solve_linear(in.getEpetraVector(), out.getEpetraVector());
   }
   bool applyRightPreconditioning(bool, Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
                                  NOX::Epetra::Vector &out) const override {
@@ -80,7 +94,7 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   void resetScaling(const Teuchos::RCP<NOX::Epetra::Scaling> &) override {}
   bool computeJacobian(const NOX::Epetra::Vector &x) override {
     if (s_.may_reuse_jacobian()) return true;  // keep matrix and factors
-    return i_.computeJacobian(x.getEpetraVector(), *s_.jacobian_matrix);
+    return i_.computeJacobian(x.getEpetraVector(), *s_.jacobian_operator());
   }
   bool createPreconditioner(const NOX::Epetra::Vector &, Teuchos::ParameterList &,
                             bool) const override { return false; }
@@ -91,9 +105,9 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   bool isPreconditionerConstructed() const override { return false; }
   bool hasPreconditioner() const override { return false; }
   Teuchos::RCP<const Epetra_Operator> getJacobianOperator() const override {
-    return s_.jacobian_matrix;
+    return s_.jacobian_operator();
   }
-  Teuchos::RCP<Epetra_Operator> getJacobianOperator() override { return s_.jacobian_matrix; }
+  Teuchos::RCP<Epetra_Operator> getJacobianOperator() override { return s_.jacobian_operator(); }
   Teuchos::RCP<const Epetra_Operator> getGeneratedPrecOperator() const override {
     return Teuchos::null;
   }
@@ -122,7 +136,9 @@ class ResidualRecorder : public NOX::Observer {
 };
 
 // Our status tests: `outcome` once a condition holds, Unconverged before;
-// print() names the condition.
+// print() names the condition. Each check decides afresh (from the solver
+// and the Solver's counters of the current step), so one test object
+// serves every step.
 class ConditionTest : public NOX::StatusTest::Generic {
  public:
   ConditionTest(NOX::StatusTest::StatusType outcome, std::string what)
@@ -163,16 +179,22 @@ class AtLeastOneIteration : public ConditionTest {
 // Converged (with at least one update) once every c entry of the last
 // update is within update_atol + update_rtol |c| (sp_step_data): the time
 // control's tolerance, scaled down, decides how exactly a step is solved.
-// The state is (c, mu) per pair: even global indices are c.
+// The tolerances are the step's (set_tolerances); both 0 switch the test
+// off (it never holds and reduces nothing). The state is (c, mu) per pair:
+// even global indices are c.
 class UpdateSmall : public ConditionTest {
  public:
-  UpdateSmall(MPI_Comm comm, double rtol, double atol)
+  explicit UpdateSmall(MPI_Comm comm)
       : ConditionTest(NOX::StatusTest::Converged, "|dc| <= update_atol + update_rtol |c|"),
-        comm_(comm), rtol_(rtol), atol_(atol) {}
+        comm_(comm) {}
+  void set_tolerances(double rtol, double atol) {
+    rtol_ = rtol;
+    atol_ = atol;
+  }
 
  protected:
   bool holds(const NOX::Solver::Generic &solver) const override {
-    if (solver.getNumIterations() < 1) return false;
+    if (!(rtol_ > 0 || atol_ > 0) || solver.getNumIterations() < 1) return false;
     const auto &x = dynamic_cast<const NOX::Epetra::Vector &>(solver.getSolutionGroup().getX())
                         .getEpetraVector();
     const auto &xp = dynamic_cast<const NOX::Epetra::Vector &>(
@@ -189,7 +211,7 @@ class UpdateSmall : public ConditionTest {
 
  private:
   MPI_Comm comm_;
-  double rtol_, atol_;
+  double rtol_ = 0, atol_ = 0;
 };
 
 // Modified Newton's iteration limit: this many factorisations (each
@@ -234,6 +256,29 @@ class RelativeDivergence : public ConditionTest {
 };
 
 }  // namespace
+
+// What NOX needs for a step, built ahead of the steps; Solver::step only
+// loads its guess and tolerances.
+struct Solver::Nox {
+  // Once per solver: they depend on the options only.
+  Teuchos::RCP<Teuchos::ParameterList> params;
+  Teuchos::RCP<std::ostringstream> errors;  // NOX's error stream (cleared each step)
+  Teuchos::RCP<NOX::StatusTest::Generic> tests;
+  // ||F|| < newton_rtol ||F(guess)||: NOX's relative NormF takes ||F(guess)||
+  // from the group it is built with, so this one is an absolute NormF whose
+  // tolerance each step sets to the product NOX's relative test forms.
+  Teuchos::RCP<NOX::StatusTest::NormF> relative;
+  Teuchos::RCP<UpdateSmall> update;           // the step's update tolerances
+  Teuchos::RCP<RelativeDivergence> diverged;  // null: newton_divergence off
+  int max_its = 0;
+  // Once per layout (set_problem): vectors on the layout's map.
+  Teuchos::RCP<StepInterface> iface;
+  Teuchos::RCP<NOX::Epetra::Vector> guess;
+  Teuchos::RCP<NOX::Epetra::Group> group;
+  Teuchos::RCP<NOX::Solver::Generic> solver;
+};
+
+Solver::~Solver() = default;
 
 Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     : comm_(comm), options_(options) {
@@ -290,6 +335,75 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     default: throw input_error("solver.linear: unknown kind");
   }
   linear_ = std::make_unique<LowRankSolver>(comm, std::move(direct));
+
+  nox_ = std::make_unique<Nox>();
+  auto params = Teuchos::rcp(new Teuchos::ParameterList);
+  params->set("Nonlinear Solver", "Line Search Based");
+  // Backtrack: NOX's defaults (halve the step until the sum of squares of
+  // F falls, down to 1e-12, else the full step), spelled out.
+  Teuchos::ParameterList &search = params->sublist("Line Search");
+  if (options_.line_search == SP_SOLVER_STEP_BACKTRACK) {
+    search.set("Method", "Backtrack");
+    search.sublist("Backtrack").set("Default Step", 1.0);
+    search.sublist("Backtrack").set("Reduction Factor", 0.5);
+    search.sublist("Backtrack").set("Minimum Step", 1e-12);
+    search.sublist("Backtrack").set("Max Iters", 100);
+  } else {
+    search.set("Method", "Full Step");
+  }
+  params->sublist("Direction").set("Method", "Newton");
+  params->sublist("Direction").sublist("Newton").set("Rescue Bad Newton Solve", false);
+  params->sublist("Printing").set("Output Information", 0);
+  // NOX prints its errors before throwing: keep them for the message.
+  nox_->errors = Teuchos::rcp(new std::ostringstream);
+  params->sublist("Printing").set<Teuchos::RCP<std::ostream>>("Error Stream", nox_->errors);
+  params->sublist("Solver Options").set("Status Test Check Type", "Complete");
+  params->sublist("Solver Options").set<Teuchos::RCP<NOX::Observer>>(
+      "User Defined Pre/Post Operator", Teuchos::rcp(new ResidualRecorder(*this)));
+  nox_->params = params;
+
+  // Converged: (||F|| < newton_atol, or < newton_rtol ||F(guess)||, or the
+  // update below the step's update tolerances) after at least one update.
+  // Failed: F not finite, the iteration limits, ||F|| > 1e30, or (with
+  // newton_divergence) ||F|| above that factor of ||F(guess)||.
+  using namespace NOX::StatusTest;
+  auto converged = Teuchos::rcp(new Combo(Combo::AND));
+  auto tolerance = Teuchos::rcp(new Combo(Combo::OR));
+  tolerance->addStatusTest(Teuchos::rcp(new NormF(options_.newton_atol, NormF::Unscaled)));
+  nox_->relative = Teuchos::rcp(new NormF(0.0, NormF::Unscaled));
+  tolerance->addStatusTest(nox_->relative);
+  nox_->update = Teuchos::rcp(new UpdateSmall(comm_.Comm()));
+  tolerance->addStatusTest(nox_->update);
+  converged->addStatusTest(tolerance);
+  converged->addStatusTest(Teuchos::rcp(new AtLeastOneIteration));
+  auto all = Teuchos::rcp(new Combo(Combo::OR));
+  all->addStatusTest(Teuchos::rcp(new FiniteValue));
+  all->addStatusTest(converged);
+  // Newton: newton_max_its iterations; modified Newton: as many
+  // factorisations, and at most twice as many iterations.
+  nox_->max_its = options_.jacobian_reuse > 0 ? 2 * options_.newton_max_its
+                                              : options_.newton_max_its;
+  if (options_.jacobian_reuse > 0)
+    all->addStatusTest(Teuchos::rcp(new FactorisationLimit(*this, options_.newton_max_its)));
+  all->addStatusTest(Teuchos::rcp(new MaxIters(nox_->max_its)));
+  all->addStatusTest(Teuchos::rcp(new Divergence(1e30)));
+  if (options_.newton_divergence > 0) {
+    nox_->diverged = Teuchos::rcp(new RelativeDivergence(*this, options_.newton_divergence));
+    all->addStatusTest(nox_->diverged);
+  }
+  nox_->tests = all;
+}
+
+void Solver::build_nox_solve() {
+  Nox &n = *nox_;
+  n.solver = Teuchos::null;  // (it holds the old group)
+  n.iface = Teuchos::rcp(new StepInterface(*this));
+  auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *n.iface));
+  n.guess = Teuchos::rcp(new NOX::Epetra::Vector(Epetra_Vector(assembly_->map())));
+  n.group = Teuchos::rcp(
+      new NOX::Epetra::Group(n.params->sublist("Printing"), n.iface, *n.guess, linsys));
+  // (evaluates nothing: F is first computed in step)
+  n.solver = NOX::Solver::buildSolver(n.group, n.tests, n.params);
 }
 
 void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout) {
@@ -302,7 +416,8 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   const Epetra_CrsGraph &g = assembly_->graph();
   const int n = g.NumMyRows();
   agree_local(comm_, [&] {  // (the gathers below are collective)
-    jacobian_matrix = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
+    jacobian_matrix_ = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
+    build_nox_solve();
     first_row_ = n > 0 ? g.RowMap().GID(0) : 0;
     for (int i = 0; i < n; ++i)
       if (g.RowMap().GID(i) != first_row_ + i)
@@ -323,7 +438,7 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   // backend that only reads them reads the Jacobian's own storage, and no
   // copy is made.
   rows_in_place_ = P == 1 && !linear_->overwrites_values() &&
-                   jacobian_matrix->StorageOptimized() &&
+                   jacobian_matrix_->StorageOptimized() &&
                    g.ColMap().NumMyElements() == n_global_;
   for (int k = 0; rows_in_place_ && k < g.ColMap().NumMyElements(); ++k)
     rows_in_place_ = g.ColMap().GID(k) == k;
@@ -381,7 +496,7 @@ void Solver::fill_residual(const sp_step_data &d, const Epetra_Vector &x, Epetra
   double t0 = now();
   gather(x, full_);
   assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), F);
-  t_assembly += now() - t0;
+  t_assembly_ += now() - t0;
 }
 
 void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
@@ -390,7 +505,7 @@ void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
   // The element Jacobians take the shape coefficients as constants; their
   // dependence on the moments is the low-rank part (prepare_shape).
   assembly_->jacobian(shape_.data_at(d, *assembly_, full_.data()), full_.data(),
-                      options_.jacobian, *jacobian_matrix);
+                      options_.jacobian, *jacobian_matrix_);
   jacobian_fresh_ = true;
   if (carries()) {
     jac_x_ = full_;
@@ -399,7 +514,7 @@ void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
     if (d.shape) jac_shape_.assign(d.shape, d.shape + assembly_->n_cells());
     else jac_shape_.clear();
   }
-  t_assembly += now() - t0;
+  t_assembly_ += now() - t0;
 }
 
 void Solver::prepare_shape(const sp_step_data &d) {
@@ -408,9 +523,9 @@ void Solver::prepare_shape(const sp_step_data &d) {
 }
 
 bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out, bool transpose) {
-  jacobian_matrix->SetUseTranspose(transpose);
-  const bool ok = jacobian_matrix->Apply(in, out) == 0;
-  jacobian_matrix->SetUseTranspose(false);
+  jacobian_matrix_->SetUseTranspose(transpose);
+  const bool ok = jacobian_matrix_->Apply(in, out) == 0;
+  jacobian_matrix_->SetUseTranspose(false);
   if (!ok) return false;
   linear_->term().add_apply(comm_.Comm(), in.Values(), out.Values(), transpose);
   return true;
@@ -473,7 +588,7 @@ bool Solver::may_reuse_jacobian() const {
 
 bool Solver::factor_jacobian(std::string &why) {
   double t0 = now();
-  const int n = jacobian_matrix->NumMyRows();
+  const int n = jacobian_matrix_->NumMyRows();
   CsrRows A;
   A.n_global = n_global_;
   A.first_row = first_row_;
@@ -481,17 +596,17 @@ bool Solver::factor_jacobian(std::string &why) {
   if (rows_in_place_) {
     int *offsets, *cols;
     double *vals;
-    if (jacobian_matrix->ExtractCrsDataPointers(offsets, cols, vals) != 0)
+    if (jacobian_matrix_->ExtractCrsDataPointers(offsets, cols, vals) != 0)
       throw std::logic_error("the Jacobian's storage is not contiguous");
     A.row_ptr = offsets;
     A.col = cols;
     A.val = vals;
-    A.matrix = jacobian_matrix.get();
+    A.matrix = jacobian_matrix_.get();
   } else {
     for (int i = 0; i < n; ++i) {
       int len;
       double *vals;
-      jacobian_matrix->ExtractMyRowView(i, len, vals);
+      jacobian_matrix_->ExtractMyRowView(i, len, vals);
       for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = vals[csr_from_[k]];
     }
     A.row_ptr = csr_ptr_.data();
@@ -501,7 +616,7 @@ bool Solver::factor_jacobian(std::string &why) {
   linear_->set_rhs_count(1);
   bool ok = linear_->factor(A, !pattern_changed_, why);
   ok = all_agree(comm_.Comm(), ok, why);
-  t_factor += now() - t0;
+  t_factor_ += now() - t0;
   if (!ok) {
     pattern_changed_ = true;  // start the next factorisation from scratch
     return false;
@@ -512,15 +627,20 @@ bool Solver::factor_jacobian(std::string &why) {
   return true;
 }
 
-bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why) {
+bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x) {
+  std::string why;
   const bool fresh = jacobian_fresh_;
-  if (fresh && !factor_jacobian(why)) return false;
+  if (fresh && !factor_jacobian(why)) {
+    linear_failure_ = why;
+    return false;
+  }
   // (the first solve after a factorisation also does the low-rank term's
   // block solve and small factorisation: counted as solve time)
   double t0 = now();
   bool ok = linear_->solve(b.Values(), x.Values(), why);
-  t_solve += now() - t0;
+  t_solve_ += now() - t0;
   if (!ok && fresh) jacobian_fresh_ = true;  // refactor before the next solve
+  if (!ok) linear_failure_ = why;
   return ok;
 }
 
@@ -530,13 +650,16 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
       (d.update_rtol > 0 && !(d.update_atol > 0)))
     throw input_error("sp_step_data: expected update_atol > 0 with update_rtol > 0, both >= 0");
   report = sp_step_report{};
-  t_assembly = t_factor = t_solve = 0;
+  t_assembly_ = t_factor_ = t_solve_ = 0;
   step_factorisations_ = 0;
   step_norms_.clear();
+  linear_failure_.clear();
   const double t_start = now();
   const long linear_its_before = linear_->iterations();
+  Nox &n = *nox_;
+  const StepInterface::Scope scope(*n.iface, d);
+  Epetra_Vector &x0 = n.guess->getEpetraVector();
   const Epetra_Map &map = assembly_->map();
-  Epetra_Vector x0(map);
   for (int i = 0; i < map.NumMyElements(); ++i) x0[i] = state[map.GID(i)];
 
   prepare_shape(d);
@@ -545,90 +668,44 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   // step's shape coefficients); the first iteration's contraction decides.
   carried_ = factor_carryable() && linear_->term().empty();
   last_converged_ = false;
-  auto iface = Teuchos::rcp(new StepInterface(*this, d));
-  auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *iface));
-  auto params = Teuchos::rcp(new Teuchos::ParameterList);
-  params->set("Nonlinear Solver", "Line Search Based");
-  // Backtrack: NOX's defaults (halve the step until the sum of squares of
-  // F falls, down to 1e-12, else the full step), spelled out.
-  Teuchos::ParameterList &search = params->sublist("Line Search");
-  if (options_.line_search == SP_SOLVER_STEP_BACKTRACK) {
-    search.set("Method", "Backtrack");
-    search.sublist("Backtrack").set("Default Step", 1.0);
-    search.sublist("Backtrack").set("Reduction Factor", 0.5);
-    search.sublist("Backtrack").set("Minimum Step", 1e-12);
-    search.sublist("Backtrack").set("Max Iters", 100);
-  } else {
-    search.set("Method", "Full Step");
-  }
-  params->sublist("Direction").set("Method", "Newton");
-  params->sublist("Direction").sublist("Newton").set("Rescue Bad Newton Solve", false);
-  params->sublist("Printing").set("Output Information", 0);
-  // NOX prints its errors before throwing: keep them for the message.
-  auto nox_errors = Teuchos::rcp(new std::ostringstream);
-  params->sublist("Printing").set<Teuchos::RCP<std::ostream>>("Error Stream", nox_errors);
-  params->sublist("Solver Options").set("Status Test Check Type", "Complete");
-  params->sublist("Solver Options").set<Teuchos::RCP<NOX::Observer>>(
-      "User Defined Pre/Post Operator", Teuchos::rcp(new ResidualRecorder(*this)));
-  NOX::Epetra::Vector guess(x0, NOX::DeepCopy);
-  auto group = Teuchos::rcp(new NOX::Epetra::Group(params->sublist("Printing"), iface, guess, linsys));
+  // The guess into the group (every value it held is now invalid), F at the
+  // guess, and the step's tolerances into the tests. F(guess) is evaluated
+  // here once, as NOX's relative NormF did when it was built per step; the
+  // fill is not a Newton iteration's work but is counted in assembly.
+  n.solver->reset(*n.guess);
+  n.group->computeF();
+  n.relative->reset(options_.newton_rtol * n.group->getNormF());
+  n.update->set_tolerances(d.update_rtol, d.update_atol);
+  n.errors->str("");
+  n.errors->clear();
 
-  using namespace NOX::StatusTest;
-  auto converged = Teuchos::rcp(new Combo(Combo::AND));
-  auto tolerance = Teuchos::rcp(new Combo(Combo::OR));
-  tolerance->addStatusTest(Teuchos::rcp(new NormF(options_.newton_atol, NormF::Unscaled)));
-  tolerance->addStatusTest(Teuchos::rcp(new NormF(*group, options_.newton_rtol, NormF::Unscaled)));
-  if (d.update_rtol > 0 || d.update_atol > 0)
-    tolerance->addStatusTest(
-        Teuchos::rcp(new UpdateSmall(comm_.Comm(), d.update_rtol, d.update_atol)));
-  converged->addStatusTest(tolerance);
-  converged->addStatusTest(Teuchos::rcp(new AtLeastOneIteration));
-  auto all = Teuchos::rcp(new Combo(Combo::OR));
-  all->addStatusTest(Teuchos::rcp(new FiniteValue));
-  all->addStatusTest(converged);
-  // Newton: newton_max_its iterations; modified Newton: as many
-  // factorisations, and at most twice as many iterations.
-  const int max_its = options_.jacobian_reuse > 0 ? 2 * options_.newton_max_its
-                                                  : options_.newton_max_its;
-  if (options_.jacobian_reuse > 0)
-    all->addStatusTest(Teuchos::rcp(new FactorisationLimit(*this, options_.newton_max_its)));
-  all->addStatusTest(Teuchos::rcp(new MaxIters(max_its)));
-  all->addStatusTest(Teuchos::rcp(new Divergence(1e30)));
-  Teuchos::RCP<RelativeDivergence> diverged;
-  if (options_.newton_divergence > 0) {
-    diverged = Teuchos::rcp(new RelativeDivergence(*this, options_.newton_divergence));
-    all->addStatusTest(diverged);
-  }
-  // The relative test evaluated F at the guess: that fill is not a Newton
-  // iteration's work but is counted in assembly all the same.
-
-  auto solver = NOX::Solver::buildSolver(group, all, params);
-  last_error.clear();
-  // A failed linear solve (applyJacobianInverse false, last_error set):
+  // A failed linear solve (applyJacobianInverse false, linear_failure_ set):
   // NOX's Newton direction throws; the attempt failed, as a diverging one.
   // Any other NOX error ends the run with what NOX printed.
-  StatusType status = Failed;
+  using NOX::StatusTest::Converged;
+  using NOX::StatusTest::Failed;
+  NOX::StatusTest::StatusType status = Failed;
   try {
-    status = solver->solve();
+    status = n.solver->solve();
   } catch (...) {
-    if (last_error.empty()) {
-      std::string text = nox_errors->str();
+    if (linear_failure_.empty()) {
+      std::string text = n.errors->str();
       while (!text.empty() && std::isspace((unsigned char)text.back())) text.pop_back();
       if (text.empty()) throw;
       throw std::runtime_error("NOX: " + text);
     }
   }
-  report.newton_its = solver->getNumIterations();
+  report.newton_its = n.solver->getNumIterations();
   report.factorisations = step_factorisations_;
   report.linear_its = linear_->iterations() - linear_its_before;
   report.n_residuals = (int)std::min<size_t>(step_norms_.size(), SP_MAX_NEWTON_HISTORY);
   std::copy(step_norms_.begin(), step_norms_.begin() + report.n_residuals, report.residual_norms);
-  report.t_assembly = t_assembly;
-  report.t_factor = t_factor;
-  report.t_solve = t_solve;
+  report.t_assembly = t_assembly_;
+  report.t_factor = t_factor_;
+  report.t_solve = t_solve_;
   if (status == Converged) {
     const auto &xs = dynamic_cast<const NOX::Epetra::Vector &>(
-        solver->getSolutionGroup().getX()).getEpetraVector();
+        n.solver->getSolutionGroup().getX()).getEpetraVector();
     gather(xs, full_);
     std::copy(full_.begin(), full_.end(), state);
     report.converged = 1;
@@ -639,10 +716,13 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   const double last = report.n_residuals ? report.residual_norms[report.n_residuals - 1] : NAN;
   char ratio[32];
   snprintf(ratio, sizeof ratio, "%g", options_.newton_divergence);
-  report.failure = !last_error.empty() ? SP_NEWTON_LINEAR_FAILED
+  // (the divergence test's status is this solve's: every test is checked at
+  // the guess and after each iteration)
+  report.failure = !linear_failure_.empty() ? SP_NEWTON_LINEAR_FAILED
                    : !std::isfinite(last) ? SP_NEWTON_NOT_FINITE
-                   : !diverged.is_null() && diverged->getStatus() == Failed ? SP_NEWTON_DIVERGED
-                   : report.newton_its >= max_its ||
+                   : !n.diverged.is_null() && n.diverged->getStatus() == Failed
+                       ? SP_NEWTON_DIVERGED
+                   : report.newton_its >= n.max_its ||
                              report.factorisations >= options_.newton_max_its
                        ? SP_NEWTON_MAX_ITERATIONS
                        : SP_NEWTON_OTHER_FAILURE;
@@ -650,7 +730,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
                              std::to_string(report.factorisations) + " factorisations)";
   std::string why;
   switch (report.failure) {
-    case SP_NEWTON_LINEAR_FAILED: why = last_error; break;
+    case SP_NEWTON_LINEAR_FAILED: why = linear_failure_; break;
     case SP_NEWTON_NOT_FINITE: why = "the residual is not finite"; break;
     case SP_NEWTON_DIVERGED:
       why = "diverged: |F| above " + std::string(ratio) + " x the first |F| after " + counts;
@@ -660,7 +740,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   }
   snprintf(report.reason, sizeof report.reason, "%s (last |F| = %.3g)", why.c_str(), last);
   report.t_total = now() - t_start;
-  return 1;  // state untouched: x0 was a copy
+  return 1;  // state untouched: the guess was a copy
 }
 
 sp_energy_parts Solver::energy(const sp_model_params &m, const double *state) const {

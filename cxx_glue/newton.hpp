@@ -1,7 +1,10 @@
 // The object behind the sp_solver handle: an Assembly for the current
 // layout, the Jacobian (a sparse matrix and, with the implicit shape term,
-// a low-rank part beside it), a linear solver for it, and one NOX Newton
-// solve per backward-Euler step.
+// a low-rank part beside it), a linear solver for it, and NOX's Newton
+// solve of each time step's equations. What NOX needs is built ahead of the
+// steps (newton.cpp, Solver::Nox): the parameter list and the status tests
+// once per solver, the group and the NOX solver once per layout; a step
+// only loads its guess and its tolerances into them.
 #ifndef SP_NEWTON_HPP
 #define SP_NEWTON_HPP
 
@@ -24,6 +27,9 @@ namespace sp {
 class Solver {
  public:
   Solver(MPI_Comm comm, const sp_solver_options &options);
+  ~Solver();  // (out of line: Nox is complete only in newton.cpp)
+  Solver(const Solver &) = delete;
+  Solver &operator=(const Solver &) = delete;
 
   void set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout);
   /// Whether the next step may begin on the current factorisation
@@ -35,7 +41,7 @@ class Solver {
   /// on it, as in the run whose carry_point this is.
   void carry_restore(const sp_step_data &d, const double *x);
   int ranks() const { return comm_.NumProc(); }
-  // Returns 0 when converged, 1 when Newton failed (state restored).
+  // Returns 0 when converged, 1 when Newton failed (state untouched).
   int step(const sp_step_data &data, double *state, sp_step_report &report);
   sp_energy_parts energy(const sp_model_params &m, const double *state) const;
   // (not const: an implicit shape term needs its weights for data)
@@ -51,7 +57,11 @@ class Solver {
   // Called by the NOX interface and linear system (newton.cpp).
   void fill_residual(const sp_step_data &data, const Epetra_Vector &x, Epetra_Vector &F);
   void fill_jacobian(const sp_step_data &data, const Epetra_Vector &x);
-  bool solve_linear(const Epetra_Vector &b, Epetra_Vector &x, std::string &why);
+  // Solves J x = b (factoring J first if it changed); false: the reason is
+  // kept for the step's report (a failed linear solve fails the attempt).
+  bool solve_linear(const Epetra_Vector &b, Epetra_Vector &x);
+  // The sparse part of J, the operator NOX's linear system hands out.
+  const Teuchos::RCP<Epetra_FECrsMatrix> &jacobian_operator() const { return jacobian_matrix_; }
   // out = J in (or J^T in), J the sparse matrix plus the implicit shape
   // term's low-rank part.
   bool apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out, bool transpose);
@@ -68,11 +78,14 @@ class Solver {
   // ||F|| at the current step's guess (NaN before it is recorded).
   double step_first_norm() const { return step_norms_.empty() ? NAN : step_norms_.front(); }
 
-  std::string last_error;
-  Teuchos::RCP<Epetra_FECrsMatrix> jacobian_matrix;
-  double t_assembly = 0, t_factor = 0, t_solve = 0;
-
  private:
+  // NOX's side of the solve (newton.cpp): the parameter list and the status
+  // tests, built by the constructor; the group (the Newton iterate and its
+  // F, J, update) and the NOX solver over it, built by set_problem for each
+  // layout.
+  struct Nox;
+  // Builds NOX's group and solver on the current layout's map.
+  void build_nox_solve();
   void require_problem() const;
   // A step's implicit shape term: its coefficients (shape_) and its
   // Jacobian part, handed to the linear solver.
@@ -80,11 +93,20 @@ class Solver {
   // The full (replicated) state from a distributed vector.
   void gather(const Epetra_Vector &x, std::vector<double> &full) const;
 
+  // The sparse part of J. Declared first, so destroyed last: a backend
+  // (MUMPS through Amesos) still reaches the matrix when it is destroyed.
+  Teuchos::RCP<Epetra_FECrsMatrix> jacobian_matrix_;
+  // Why the current step's last linear solve failed (empty: none did).
+  std::string linear_failure_;
+  // Seconds of the current step: residual and Jacobian fills,
+  // factorisations, solves (sp_step_report).
+  double t_assembly_ = 0, t_factor_ = 0, t_solve_ = 0;
   Epetra_MpiComm comm_;
   sp_solver_options options_;
   std::unique_ptr<Assembly> assembly_;
   // The backend of solver.linear inside the low-rank (Woodbury) wrapper.
   std::unique_ptr<LowRankSolver> linear_;
+  std::unique_ptr<Nox> nox_;
   std::vector<int> csr_ptr_, csr_col_;  // this rank's rows: pattern, global columns (sorted)
   std::vector<int> csr_from_;           // position of each entry in its Epetra row
   int first_row_ = 0, n_global_ = 0;    // the rows are first_row_ .. + n_rows - 1
@@ -106,7 +128,7 @@ class Solver {
   int jac_shape_implicit_ = 0;
   std::vector<double> jac_x_;
   std::vector<sp_shape_coef> jac_shape_;
-  // Factor jacobian_matrix (solve_linear's first part); false: why says.
+  // Factor jacobian_matrix_ (solve_linear's first part); false: why says.
   bool factor_jacobian(std::string &why);
   // Factorisations may carry across steps (jacobian_carry, with modified
   // Newton), and the current one may: the last step converged on it, on
