@@ -17,7 +17,9 @@
 #include <dlfcn.h>
 #include <math.h>
 #include <mpi.h>
+#include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -120,23 +122,66 @@ static int draw_progress(const sp_step_info *s, void *user) {
  *  (EX_TEMPFAIL: "try again", here with --resume). */
 #define SP_EXIT_STOPPED 75
 
-/** The first signal asks for a checkpoint at the end of the step; a
- *  second one (^C again) ends the process at once, as without a handler. */
+/* The stop signals: SIGTERM (a job's time limit), SIGINT (^C), SIGUSR1 (a
+ * scheduler's warning). The first asks for a checkpoint at the end of the
+ * step in progress and a stop (in `softpack run`, once the run has begun);
+ * a second one (^C again), or any before the run, ends the process at once,
+ * as without a handler.
+ *
+ * They are blocked in every thread from the first line of main, before
+ * MPI_Init starts Open MPI's threads, and taken by a thread of their own
+ * (sigwait): no handler runs inside the solver. A handler is not enough
+ * (issue 27, "SIGTERM: status 139"; tools/sigterm_in_metis.sh): Debian's
+ * METIS (GKlib) installs its own SIGTERM handler for the length of
+ * METIS_NodeND (gk_sigtrap) and longjmps out of it on a SIGTERM. METIS then
+ * returns METIS_ERROR with the ordering unwritten, SuperLU_DIST (which does
+ * not look at the code) factorises with that garbage column permutation and
+ * segfaults in sp_colorder, and the stop never reaches softpack: no
+ * checkpoint, no message. GKlib also puts the handler it displaced back with
+ * System V semantics (one-shot, no SA_RESTART). A blocked signal waits for
+ * sigwait whatever handler is installed. The handler below stays for threads
+ * started before main with the signals unblocked (OpenBLAS's, which
+ * hold_signals restarts blocked). */
+static sigset_t stop_signals;
+static atomic_int stop_signals_seen;
+static atomic_int run_stops; /* 1 once a first signal means "checkpoint and stop" */
+
+/** End the process by @p sig as without a handler. */
+static void end_by_signal(int sig) {
+  signal(sig, SIG_DFL);
+  sigset_t one;
+  sigemptyset(&one);
+  sigaddset(&one, sig);
+  pthread_sigmask(SIG_UNBLOCK, &one, NULL);
+  raise(sig);
+  _exit(128 + sig); /* (another handler got in first) */
+}
+
+/** A stop signal, taken by the waiting thread or (async-signal-safe) a handler. */
 static void on_stop_signal(int sig) {
-  static volatile sig_atomic_t seen;
-  if (seen) {
-    signal(sig, SIG_DFL);
-    raise(sig);
-    return;
-  }
-  seen = 1;
+  if (atomic_fetch_add(&stop_signals_seen, 1) > 0 || !atomic_load(&run_stops))
+    end_by_signal(sig);
   sp_run_request_stop();
 }
 
-/** SIGTERM (a job's time limit), SIGINT (^C), SIGUSR1 (a scheduler's
- *  warning): checkpoint at the end of the step in progress and stop (the
- *  first one; a second ends the process). */
-static void catch_stop_signals(void) {
+static void *wait_stop_signals(void *unused) {
+  (void)unused;
+  for (;;) {
+    int sig = 0;
+    if (sigwait(&stop_signals, &sig) == 0) on_stop_signal(sig);
+  }
+  return NULL;
+}
+
+/** Block the stop signals in this thread and every thread it starts, start
+ *  the thread that takes them, and restart OpenBLAS's threads (started when
+ *  the library was loaded, before main) so that they block them too. */
+static void hold_signals(void) {
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGUSR1);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, NULL);
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
   sa.sa_handler = on_stop_signal;
@@ -145,6 +190,18 @@ static void catch_stop_signals(void) {
   sigaction(SIGTERM, &sa, NULL);
   sigaction(SIGINT, &sa, NULL);
   sigaction(SIGUSR1, &sa, NULL);
+  /* OpenBLAS starts its threads again, from the thread that calls it */
+  int (*blas_shutdown)(void) = (int (*)(void))dlsym(RTLD_DEFAULT, "blas_thread_shutdown_");
+  if (blas_shutdown) blas_shutdown();
+  pthread_t waiter;
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
+  if (pthread_create(&waiter, &attr, wait_stop_signals, NULL) != 0) {
+    /* no thread: the handler takes them, unblocked (as before issue 27) */
+    pthread_sigmask(SIG_UNBLOCK, &stop_signals, NULL);
+  }
+  pthread_attr_destroy(&attr);
 }
 
 static int cmd_run(int argc, char **argv, int rank, int *stopped) {
@@ -183,7 +240,7 @@ static int cmd_run(int argc, char **argv, int rank, int *stopped) {
   progress prog = {.rank = rank};
   const int show = !quiet && isatty(fileno(stderr));
   if (rc == SP_OK) {
-    catch_stop_signals();
+    atomic_store(&run_stops, 1); /* a first stop signal: checkpoint and stop */
     rc = sp_run_file_restart(scene_path, n_set, sets, out_dir, &restart, MPI_COMM_WORLD,
                              show ? draw_progress : NULL, &prog, &sum);
   }
@@ -209,6 +266,7 @@ static void hold_threads(void) {
 }
 
 int main(int argc, char **argv) {
+  hold_signals(); /* before MPI_Init: its threads block them too */
   MPI_Init(&argc, &argv);
   hold_threads();
   int rank = 0;
