@@ -2,7 +2,7 @@
 #include "monitor.h"
 
 #include <math.h>
-#include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -242,11 +242,10 @@ static void count_step(sp_run *run, const sp_step_attempt *a, const sp_step_even
 
 /** Set by sp_monitor_request_stop (from a signal handler, through
  *  sp_run_request_stop): checkpoint and stop. */
-static volatile sig_atomic_t stop_requested;
+static atomic_int stop_requested; /* (lock-free: async-signal-safe; set from
+                                     softpack run's signal thread) */
 
-void sp_monitor_request_stop(void) { stop_requested = 1; }
-
-void sp_monitor_clear_stop(void) { stop_requested = 0; }
+void sp_monitor_request_stop(void) { atomic_store(&stop_requested, 1); }
 
 /** After an accepted step: write a checkpoint if one is due (every
  *  output.checkpoint_every steps, output.checkpoint_seconds since the last)
@@ -256,7 +255,7 @@ static int checkpoint_if_due(sp_run *run, int *signalled) {
   const sp_run_output *o = &run->opt.output;
   sp_monitor *mon = &run->mon;
   /* a signal may reach one rank only, and the clocks differ: agreed */
-  int want_stop = stop_requested != 0;
+  int want_stop = atomic_load(&stop_requested) != 0;
   int want_time = o->checkpoint_seconds > 0 &&
                   sp_wall_clock() - mon->t_checkpoint >= o->checkpoint_seconds;
   SP_CALL(sp_agree_any(run->agree_comm, &want_stop));
@@ -273,6 +272,9 @@ static int checkpoint_if_due(sp_run *run, int *signalled) {
   ++mon->sum->checkpoints;
   SP_CALL(sp_agree(run->agree_comm, rc)); /* every rank learns whether it was written */
   mon->t_checkpoint = sp_wall_clock();
+  /* a request is forgotten once acted on, not when a run starts: one that
+   * came while the scene was read still stops this run */
+  if (want_stop) atomic_store(&stop_requested, 0);
   /* (the run goes on as if none was written: a run continued from it
    * rebuilds the factorisation this one carries, from /carry) */
   if (want_stop && run->rank == 0) {

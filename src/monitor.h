@@ -49,11 +49,9 @@ void sp_monitor_end(sp_run *run);
 void sp_monitor_free(sp_monitor *mon);
 
 /** @brief Ask for a checkpoint at the end of the step in progress and a
- *  stop (async-signal-safe; run.h's sp_run_request_stop calls it). */
+ *  stop (async-signal-safe; run.h's sp_run_request_stop calls it). The
+ *  request stands until a run acts on it. */
 void sp_monitor_request_stop(void);
-
-/** @brief Forget an earlier request: a new run starts. */
-void sp_monitor_clear_stop(void);
 
 #ifdef __cplusplus
 }

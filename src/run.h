@@ -78,8 +78,15 @@ int sp_run_file_restart(const char *path, int n_set, const char *const *set,
 /**
  * @brief Ask the run in progress (this process's) to write a checkpoint at
  *        the end of the step in progress and stop there (summary.stopped =
- *        SP_STOPPED_SIGNAL). Async-signal-safe: `softpack run` calls it on
- *        SIGTERM, SIGINT and SIGUSR1. One rank asking stops every rank.
+ *        SP_STOPPED_SIGNAL). Async-signal-safe; a request made before a
+ *        run starts (while its scene is read) stops that run at its first
+ *        step, and is forgotten once acted on. One rank asking stops every
+ *        rank. `softpack run` calls it on SIGTERM, SIGINT and SIGUSR1, from
+ *        a thread that takes them with sigwait while every other thread
+ *        blocks them: a handler that interrupts a library can break it
+ *        (Debian's METIS, used by SuperLU_DIST, returns a garbage ordering
+ *        when a SIGTERM lands inside it; docs/restart.md). A program of
+ *        your own should do the same.
  */
 void sp_run_request_stop(void);
 

@@ -33,7 +33,6 @@ int sp_stepper_run_from(const sp_scene *scene, const sp_run_start *start, const 
   const double t0 = sp_wall_clock();
   sp_run run = {.mon = {.sum = &sum, .out_dir = out_dir, .on_step = on_step,
                         .on_step_user = user, .t_start = t0, .t_checkpoint = t0}};
-  sp_monitor_clear_stop();
   int rc = sp_run_setup(&run, scene, comm, start);
   /* Only now, with the input known good on every rank, does anything get
    * written (the other ranks write pieces into rank 0's directory). */
