@@ -193,7 +193,6 @@ static int divide_due_cells(sp_run *run, double t_old, int *n_divided) {
 int sp_events_after_step(sp_run *run, double t_old, sp_step_events *ev) {
   *ev = (sp_step_events){0};
   SP_CALL(divide_due_cells(run, t_old, &ev->n_divided));
-  ev->divisions = run->cells.divisions;
   int outgrown = 0; /* a cell reaches its support's edge */
   if (run->support && !ev->n_divided)
     SP_CALL(sp_support_needs_update(run->support, run->layout, run->state, &outgrown));
@@ -207,5 +206,6 @@ int sp_events_after_step(sp_run *run, double t_old, sp_step_events *ev) {
                                     cells->birth, cells->source_on,
                                     run->opt.terms.source_off_ratio));
   }
+  ev->divisions = run->cells.divisions; /* (after every resize of the registry) */
   return SP_OK;
 }

@@ -16,6 +16,7 @@ static int resize_array(void **ptr, size_t elem, int n_old, int n) {
 
 int sp_registry_resize(sp_registry *reg, int n) {
   const int n_old = reg->obs ? reg->n : 0;
+  if (reg->obs && n == n_old) return SP_OK; /* (a support change: the arrays stay put) */
   SP_CALL(resize_array((void **)&reg->obs, sizeof *reg->obs, n_old, n));
   SP_CALL(resize_array((void **)&reg->birth, sizeof *reg->birth, n_old, n));
   SP_CALL(resize_array((void **)&reg->source_on, sizeof *reg->source_on, n_old, n));
