@@ -36,7 +36,8 @@ typedef enum {
   SP_STEP_FATAL            /**< a hard error (sp_step_try's return code) */
 } sp_step_verdict;
 
-/** An attempt and what it cost. */
+/** An attempt and what it cost (why may point into the struct itself:
+ *  pass it by pointer, do not copy it). */
 typedef struct {
   sp_step_verdict verdict;
   double wall_start; /**< wall clock when it began */
