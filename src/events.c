@@ -57,8 +57,7 @@ int sp_events_landing(sp_run *run, double t, double dt, int *observed, double *t
         n_cells < run->n_max))
     return SP_OK;
   /* observed here, kept if the step stands */
-  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
-                           run->opt.division.observe_threshold, cells->obs_new));
+  SP_CALL(sp_run_observe(run, cells->obs_new));
   *observed = 1;
   for (int k = 0; k < n_cells; ++k) {
     const double m_old = cells->obs[k].mass_core, m_new = cells->obs_new[k].mass_core;
@@ -89,8 +88,7 @@ static int update_supports(sp_run *run, sp_step_events *ev) {
   SP_CALL(sp_run_resize(run, layout, state, SP_HISTORY_CARRY));
   SP_CALL(sp_run_energy(run, &ev->energy));
   ev->have_energy = 1;
-  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
-                           run->opt.division.observe_threshold, run->cells.obs));
+  SP_CALL(sp_run_observe(run, run->cells.obs));
   const double e_before = sp_energy_fields(&before);
   ev->support_changed = 1;
   ev->mass_correction = correction;
@@ -148,8 +146,7 @@ static int divide_cell(sp_run *run, int parent, sp_division_record *record) {
   sp_registry *cells = &run->cells;
   cells->divided_now[parent] = cells->divided_now[child] = 1;
   cells->source_on[child] = cells->source_on[parent];
-  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state,
-                           run->opt.division.observe_threshold, cells->obs));
+  SP_CALL(sp_run_observe(run, cells->obs));
   sp_cells_core_view(cells->obs, n + 1, cells->obs_new); /* (scratch) */
   sp_division_record_births(run->t, cells->obs_new, parent, child, cells->birth);
   double px, py, dx, dy;

@@ -18,6 +18,7 @@
 #include "monitor.h"
 #include "partition.h"
 #include "resize.h"
+#include "run_energy.h"
 #include "run_options.h"
 #include "solver_status.h"
 #include "support.h"
@@ -58,8 +59,7 @@ static int renumber_rcb(sp_run *run) {
 static int new_registry(sp_run *run, const sp_scene_division *dv) {
   sp_registry *cells = &run->cells;
   const int n = run->layout->n_cells;
-  SP_CALL(sp_cells_observe(run->mesh, run->layout, run->state, dv->observe_threshold,
-                           cells->obs));
+  SP_CALL(sp_run_observe(run, cells->obs));
   sp_cells_core_view(cells->obs, n, cells->obs_new); /* (scratch) */
   for (int k = 0; k < n; ++k) {
     cells->birth[k] = sp_cell_birth_make(0.0, &cells->obs_new[k], 0);
@@ -110,8 +110,7 @@ static int from_checkpoint(sp_run *run, const sp_scene *scene, const sp_run_star
   run->restarted = !start->as_initial;
   if (!start->as_initial) {
     SP_CALL(sp_checkpoint_restore_carry(start->checkpoint, run));
-    return sp_cells_observe(run->mesh, run->layout, run->state,
-                            scene->division.observe_threshold, run->cells.obs);
+    return sp_run_observe(run, run->cells.obs);
   }
   SP_CALL(new_registry(run, &scene->division)); /* observes too */
   *reference_mass = run->cells.birth[0].birth_mass;
@@ -120,7 +119,7 @@ static int from_checkpoint(sp_run *run, const sp_scene *scene, const sp_run_star
 
 /** The initial fields cut to the initial supports: background and noise
  *  exist only there (docs/local-support.md). */
-static int cut_to_supports(sp_run *run, const sp_scene *scene) {
+static int cut_to_supports(sp_run *run) {
   const int n = run->layout->n_cells;
   unsigned char *mask;
   SP_ALLOC(mask, (size_t)run->mesh->n_nodes * n);
@@ -136,8 +135,7 @@ static int cut_to_supports(sp_run *run, const sp_scene *scene) {
   }
   sp_layout_transfer(run->layout, run->state, layout, state, 0.0);
   SP_CALL(sp_run_resize(run, layout, state, SP_HISTORY_RESET));
-  return sp_cells_observe(run->mesh, run->layout, run->state, scene->division.observe_threshold,
-                          run->cells.obs);
+  return sp_run_observe(run, run->cells.obs);
 }
 
 /** The mesh, the solver and the initial cells on the full layout, in RCB
@@ -179,7 +177,7 @@ static int setup(sp_run *run, const sp_scene *scene, MPI_Comm comm, const sp_run
   double reference_mass = run->cells.birth[0].birth_mass;
   SP_CALL(maybe_local_supports(run, scene, n));
   if (start && start->checkpoint) SP_CALL(from_checkpoint(run, scene, start, &reference_mass));
-  else if (run->support) SP_CALL(cut_to_supports(run, scene));
+  else if (run->support) SP_CALL(cut_to_supports(run));
   else SP_CALL(sp_run_resize(run, run->layout, run->state, SP_HISTORY_RESET));
   /* (With local supports the solver sees only the local layout: the full
    * one's graph couples every pair of cells at every node, N^2 x nodes

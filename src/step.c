@@ -10,6 +10,7 @@
 #include "error.h"
 #include "events.h"
 #include "fault.h"
+#include "run_energy.h"
 #include "shape.h"
 #include "solver_status.h"
 #include "source.h"
@@ -30,6 +31,11 @@ int sp_step_run_ends(const sp_run *run) {
   return !(run->t < tc->t_end - 1e-12 * tc->t_end && run->step < tc->max_steps);
 }
 
+/** The scene has a shape term (shape.delta1 or shape.delta2 > 0). */
+static int shape_on(const sp_run_terms *terms) {
+  return terms->shape_delta1 > 0 || terms->shape_delta2 > 0;
+}
+
 /** The step's source and shape coefficients from c^n (the state before the
  *  step and its observables). */
 static int explicit_terms(sp_run *run) {
@@ -39,7 +45,7 @@ static int explicit_terms(sp_run *run) {
   if (terms->source_rate > 0)
     SP_CALL(sp_source_fill(run->layout, run->buf.state_old, n_cells, cells->source_on,
                            terms->source_rate, run->buf.source));
-  if (!(terms->shape_delta1 > 0 || terms->shape_delta2 > 0)) return SP_OK;
+  if (!shape_on(terms)) return SP_OK;
   /* from the observables of c^n; implicit steps follow the new moments
    * through the gains */
   SP_CALL(sp_shape_coefficients(n_cells, cells->obs, cells->birth, terms->shape_delta1,
@@ -57,8 +63,7 @@ static sp_step_data step_data(sp_run *run, sp_scheme_kind kind, double dt) {
   const sp_run_options *o = &run->opt;
   sp_step_data data = {.dt = dt, .model = o->model, .state_old = run->buf.state_old,
                        .source = o->terms.source_rate > 0 ? run->buf.source : NULL,
-                       .shape = o->terms.shape_delta1 > 0 || o->terms.shape_delta2 > 0
-                                    ? run->cells.shape : NULL,
+                       .shape = shape_on(&o->terms) ? run->cells.shape : NULL,
                        .shape_implicit = o->terms.shape_implicit};
   if (kind != SP_SCHEME_BE) {
     sp_scheme_be_form(kind, &run->hist, dt, run->buf.state_old, (size_t)run->layout->n_pairs,
@@ -152,6 +157,5 @@ int sp_step_complete(sp_run *run, const sp_step_attempt *a) {
     memcpy(cells->obs, cells->obs_new, sizeof *cells->obs * (size_t)n_cells);
     return SP_OK;
   }
-  return sp_cells_observe(run->mesh, run->layout, run->state, o->division.observe_threshold,
-                          cells->obs);
+  return sp_run_observe(run, cells->obs);
 }
