@@ -109,12 +109,16 @@ typedef struct {
   double krylov_tol;
 } sp_solver_options;
 
-/** The mesh, borrowed (must outlive the solver's use of it). */
+/** The mesh, borrowed (must outlive the solver's use of it): Q1
+ *  quadrilaterals (dim 2, 4 nodes per element) or hexahedra (dim 3, 8),
+ *  nodes in the order of src/q1.h. */
 typedef struct {
   int n_nodes, n_elems;
-  const double *xy;       /**< 2 * n_nodes */
-  const int *elem;        /**< 4 * n_elems, counterclockwise */
+  const double *xy;       /**< dim * n_nodes */
+  const int *elem;        /**< nodes_per_elem * n_elems */
   const int *region;      /**< per element, 0 = Omega, 1 = buffer ring */
+  int dim;                /**< 2 or 3 */
+  int nodes_per_elem;     /**< 4 (dim 2) or 8 (dim 3) */
 } sp_mesh_view;
 
 /** The layout, borrowed; copied by sp_solver_set_problem. */
@@ -129,13 +133,14 @@ typedef struct {
   int n_ranks;
   /** The element-slot table (src/layout.h, sp_slots; required): element
    *  e's cells are slot_cell[elem_start[e] .. elem_start[e+1]-1], by
-   *  increasing cell, each with the pairs of the element's four nodes at
-   *  slot_pair[4 s .. 4 s + 3]. The C core applies the whole-element rule
-   *  once (sp_layout_slots); the glue takes the table as it is. */
+   *  increasing cell, each with the pairs of the element's nodes at
+   *  slot_pair[n s .. n s + n - 1], n = the mesh's nodes_per_elem. The C
+   *  core applies the whole-element rule once (sp_layout_slots); the glue
+   *  takes the table as it is. */
   int64_t n_slots;
   const int64_t *elem_start; /**< n_elems + 1 (the mesh's) */
   const int *slot_cell;      /**< n_slots */
-  const int *slot_pair;      /**< 4 n_slots */
+  const int *slot_pair;      /**< nodes_per_elem n_slots */
 } sp_layout_view;
 
 /** Model parameters (MODEL.md). */

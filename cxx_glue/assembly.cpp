@@ -47,7 +47,8 @@ struct Assembly::Gathered {
 Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
                    const sp_layout_view &layout)
     : comm_(comm), n_nodes_(layout.n_nodes), n_pairs_(layout.n_pairs),
-      n_cells_(layout.n_cells) {
+      n_cells_(layout.n_cells), dim_(mesh.dim), nen_(mesh.nodes_per_elem),
+      nq_(sp_q1_qpoints(mesh.dim)) {
   // Each rank's own work before a collective is agreed first (agree_local):
   // a failure on one rank (an allocation) ends every rank here, none is
   // left in the node map's or the graph's collective.
@@ -60,6 +61,10 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
     pair_cell_.assign(layout.pair_cell, layout.pair_cell + layout.n_pairs);
     if (mesh.n_nodes != layout.n_nodes)
       throw std::runtime_error("layout and mesh disagree on the node count");
+    if ((dim_ != 2 && dim_ != 3) || nen_ != sp_q1_nodes(dim_))
+      throw std::runtime_error("the mesh view's element is not Q1: dimension " +
+                               std::to_string(dim_) + ", " + std::to_string(nen_) +
+                               " nodes per element");
     // Node partition: contiguous node ranges in rank order, so each rank's
     // DOFs are a contiguous range too (what SuperLU_DIST needs). The C core
     // balances the ranges by unknowns along an RCB node order (partition.h);
@@ -94,21 +99,30 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
                                std::to_string(mesh.n_elems) + " elements");
     elem_start_.assign(layout.elem_start, layout.elem_start + mesh.n_elems + 1);
     slot_cell_.assign(layout.slot_cell, layout.slot_cell + layout.n_slots);
-    slot_pair_.assign(layout.slot_pair, layout.slot_pair + 4 * layout.n_slots);
-    geometry_.resize(mesh.n_elems);
+    slot_pair_.assign(layout.slot_pair, layout.slot_pair + (size_t)nen_ * layout.n_slots);
+    const size_t n_points = (size_t)nq_ * mesh.n_elems;
+    geo_N_.resize(n_points * nen_);
+    geo_dNdx_.resize(n_points * nen_ * dim_);
+    geo_x_.resize(n_points * dim_);
+    geo_w_.resize(n_points);
+    geo_buffer_.resize(mesh.n_elems);
     for (int e = 0; e < mesh.n_elems; ++e) {
-      const int *nodes = mesh.elem + 4 * e;
-      ElementGeometry &g = geometry_[e];
-      double xy[4][2];
-      for (int a = 0; a < 4; ++a) {
-        xy[a][0] = mesh.xy[2 * nodes[a]];
-        xy[a][1] = mesh.xy[2 * nodes[a] + 1];
-      }
-      for (int q = 0; q < SP_Q1_QPOINTS; ++q)
-        if (sp_q1_point(xy, q, g.N[q], g.dNdx[q], g.x[q], &g.w[q]) <= 0)
+      const int *nodes = mesh.elem + (size_t)nen_ * e;
+      double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+      for (int a = 0; a < nen_; ++a)
+        for (int d = 0; d < dim_; ++d) xe[a][d] = mesh.xy[(size_t)dim_ * nodes[a] + d];
+      for (int q = 0; q < nq_; ++q) {
+        const size_t eq = (size_t)nq_ * e + q;
+        double N[SP_Q1_MAX_NODES], dNdx[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+        if (sp_q1_point(dim_, xe, q, N, dNdx, &geo_x_[eq * dim_], &geo_w_[eq]) <= 0)
           throw std::runtime_error("mesh element " + std::to_string(e) +
                                    " is inverted or degenerate");
-      g.buffer = mesh.region && mesh.region[e] == 1;
+        for (int a = 0; a < nen_; ++a) {
+          geo_N_[eq * nen_ + a] = N[a];
+          for (int d = 0; d < dim_; ++d) geo_dNdx_[(eq * nen_ + a) * dim_ + d] = dNdx[a][d];
+        }
+      }
+      geo_buffer_[e] = mesh.region && mesh.region[e] == 1;
       if (nodes[0] >= first_node && nodes[0] < end_node) my_elems_.push_back(e);
     }
 
@@ -117,14 +131,14 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
       const int nc = n_cells_on(e);
       const int64_t s0 = elem_start_[e];
       for (int j = 0; j < nc; ++j)
-        for (int a = 0; a < 4; ++a) {
-          int p = slot_pair_[4 * (s0 + j) + a];
+        for (int a = 0; a < nen_; ++a) {
+          int p = slot_pair_[nen_ * (s0 + j) + a];
           if (p < 0) continue;
           for (int f = 0; f < 2; ++f) {
             std::vector<int> cols;
             for (int j2 = 0; j2 < nc; ++j2)
-              for (int b = 0; b < 4; ++b) {
-                int p2 = slot_pair_[4 * (s0 + j2) + b];
+              for (int b = 0; b < nen_; ++b) {
+                int p2 = slot_pair_[nen_ * (s0 + j2) + b];
                 if (p2 < 0) continue;
                 for (int f2 = 0; f2 < 2; ++f2)
                   if (coupled(j, f, j2, f2)) cols.push_back(2 * p2 + f2);
@@ -155,22 +169,22 @@ void Assembly::gather(int e, const sp_step_data &d, const double *state,
   const int nc = n_cells_on(e);
   const int64_t s0 = elem_start_[e];
   g.n_cells = nc;
-  g.u.assign(8 * nc, 0.0);
-  g.c_old.assign(4 * nc, 0.0);
-  g.source.assign(4 * nc, 0.0);
-  g.dof.assign(8 * nc, -1);
+  g.u.assign(2 * nen_ * nc, 0.0);
+  g.c_old.assign(nen_ * nc, 0.0);
+  g.source.assign(nen_ * nc, 0.0);
+  g.dof.assign(2 * nen_ * nc, -1);
   g.shape.assign(nc, nullptr);
   for (int j = 0; j < nc; ++j) {
     if (d.shape) g.shape[j] = &d.shape[slot_cell_[s0 + j]];
-    for (int a = 0; a < 4; ++a) {
-      int p = slot_pair_[4 * (s0 + j) + a];
+    for (int a = 0; a < nen_; ++a) {
+      int p = slot_pair_[nen_ * (s0 + j) + a];
       if (p < 0) continue;  // outside the support: c = mu = 0, no unknown
       for (int f = 0; f < 2; ++f) {
-        g.u[(4 * j + a) * 2 + f] = state[2 * p + f];
-        g.dof[(4 * j + a) * 2 + f] = 2 * p + f;
+        g.u[(nen_ * j + a) * 2 + f] = state[2 * p + f];
+        g.dof[(nen_ * j + a) * 2 + f] = 2 * p + f;
       }
-      g.c_old[4 * j + a] = d.state_old[2 * p];
-      if (d.source) g.source[4 * j + a] = d.source[p];
+      g.c_old[nen_ * j + a] = d.state_old[2 * p];
+      if (d.source) g.source[nen_ * j + a] = d.source[p];
     }
   }
 }
@@ -181,7 +195,7 @@ namespace {
 template <class F>
 void ad_element(const ElementGeometry &geo, int nc, const double *u,
                 const ElementInputs &in, double *R, double *K) {
-  const int n = 8 * nc;
+  const int n = 2 * geo.nodes * nc;
   std::vector<F> uf(n), Rf(n);
   for (int i = 0; i < n; ++i) uf[i] = F(n, i, u[i]);
   element_residual(geo, nc, uf.data(), in, Rf.data());
@@ -194,7 +208,7 @@ void ad_element(const ElementGeometry &geo, int nc, const double *u,
 // Central finite differences of the element residual.
 void fd_element(const ElementGeometry &geo, int nc, const double *u0,
                 const ElementInputs &in, double *R, double *K) {
-  const int n = 8 * nc;
+  const int n = 2 * geo.nodes * nc;
   std::vector<double> u(u0, u0 + n), Rp(n), Rm(n);
   element_residual(geo, nc, u.data(), in, R);
   for (int j = 0; j < n; ++j) {
@@ -213,7 +227,7 @@ void fd_element(const ElementGeometry &geo, int nc, const double *u0,
 void Assembly::element_matrix(int e, const sp_step_data &d, const Gathered &g,
                               int kind, double *R, double *K) const {
   const ElementInputs in = g.inputs(d);
-  const ElementGeometry &geo = geometry_[e];
+  const ElementGeometry geo = geometry(e);
   const int nc = g.n_cells;
   const double *u = g.u.data();
   if (kind == SP_SOLVER_JAC_FD) {
@@ -229,12 +243,13 @@ void Assembly::element_matrix(int e, const sp_step_data &d, const Gathered &g,
     return;
   }
   // Statically sized Fad for the element sizes that occur most (1-4 cells
-  // on an element), dynamically sized beyond.
-  switch (nc) {
-    case 1: ad_element<Sacado::Fad::SFad<double, 8>>(geo, nc, u, in, R, K); break;
-    case 2: ad_element<Sacado::Fad::SFad<double, 16>>(geo, nc, u, in, R, K); break;
-    case 3: ad_element<Sacado::Fad::SFad<double, 24>>(geo, nc, u, in, R, K); break;
-    case 4: ad_element<Sacado::Fad::SFad<double, 32>>(geo, nc, u, in, R, K); break;
+  // on a quadrilateral, 1-2 on a hexahedron: 8 to 32 unknowns), dynamically
+  // sized beyond.
+  switch (2 * nen_ * nc) {
+    case 8: ad_element<Sacado::Fad::SFad<double, 8>>(geo, nc, u, in, R, K); break;
+    case 16: ad_element<Sacado::Fad::SFad<double, 16>>(geo, nc, u, in, R, K); break;
+    case 24: ad_element<Sacado::Fad::SFad<double, 24>>(geo, nc, u, in, R, K); break;
+    case 32: ad_element<Sacado::Fad::SFad<double, 32>>(geo, nc, u, in, R, K); break;
     default: ad_element<Sacado::Fad::DFad<double>>(geo, nc, u, in, R, K); break;
   }
 }
@@ -250,9 +265,9 @@ void Assembly::residual(const sp_step_data &d, const double *state,
     fault_in_glue(SP_FAULT_ASSEMBLY, "assembly", comm_.MyPID());
     for (int e : my_elems_) {
       gather(e, d, state, g);
-      const int n = 8 * g.n_cells;
+      const int n = 2 * nen_ * g.n_cells;
       R.assign(n, 0.0);
-      element_residual(geometry_[e], g.n_cells, g.u.data(), g.inputs(d), R.data());
+      element_residual(geometry(e), g.n_cells, g.u.data(), g.inputs(d), R.data());
       rows.clear();
       vals.clear();
       for (int i = 0; i < n; ++i)
@@ -276,17 +291,17 @@ void Assembly::jacobian(const sp_step_data &d, const double *state, int kind,
   agree_local(comm_, [&] {
     for (int e : my_elems_) {
       gather(e, d, state, g);
-      const int nc = g.n_cells, n = 8 * nc;
+      const int nc = g.n_cells, per_slot = 2 * nen_, n = per_slot * nc;
       R.assign(n, 0.0);
       K.assign((size_t)n * n, 0.0);
       element_matrix(e, d, g, kind, R.data(), K.data());
       for (int i = 0; i < n; ++i) {
         if (g.dof[i] < 0) continue;
-        const int j = i / 8, f = i % 2;
+        const int j = i / per_slot, f = i % 2;
         cols.clear();
         vals.clear();
         for (int i2 = 0; i2 < n; ++i2)
-          if (g.dof[i2] >= 0 && coupled(j, f, i2 / 8, i2 % 2)) {
+          if (g.dof[i2] >= 0 && coupled(j, f, i2 / per_slot, i2 % 2)) {
             cols.push_back(g.dof[i2]);
             vals.push_back(K[(size_t)i * n + i2]);
           }
@@ -303,28 +318,28 @@ sp_energy_parts Assembly::energy(const sp_model_params &m, const double *state) 
   double local[4] = {0, 0, 0, 0};  // bulk, gradient, repulsion, buffer
   agree_local(comm_, [&] {
     for (int e : my_elems_) {
-      const ElementGeometry &geo = geometry_[e];
+      const ElementGeometry geo = geometry(e);
       const int nc = n_cells_on(e);
       const int64_t s0 = elem_start_[e];
-      for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+      for (int q = 0; q < nq_; ++q) {
+        const double w = geo.w(q);
         double sum_sq = 0, sum_4 = 0;
         for (int j = 0; j < nc; ++j) {
-          double c = 0, gx = 0, gy = 0;
-          for (int a = 0; a < 4; ++a) {
-            int p = slot_pair_[4 * (s0 + j) + a];
+          double c = 0, gc[SP_Q1_MAX_DIM] = {0, 0, 0};
+          for (int a = 0; a < nen_; ++a) {
+            int p = slot_pair_[nen_ * (s0 + j) + a];
             double ca = p >= 0 ? state[2 * p] : 0.0;
-            c += geo.N[q][a] * ca;
-            gx += geo.dNdx[q][a][0] * ca;
-            gy += geo.dNdx[q][a][1] * ca;
+            c += geo.N(q)[a] * ca;
+            for (int d = 0; d < dim_; ++d) gc[d] += geo.dNdx(q, a)[d] * ca;
           }
-          local[0] += geo.w[q] * well(m, c);
-          local[1] += geo.w[q] * 0.5 * m.kappa * (gx * gx + gy * gy);
+          local[0] += w * well(m, c);
+          local[1] += w * 0.5 * m.kappa * grad_dot(gc, gc, dim_);
           sum_sq += c * c;
           sum_4 += c * c * c * c;
-          if (geo.buffer) local[3] += geo.w[q] * m.lambda_b * c * c;
+          if (geo.buffer) local[3] += w * m.lambda_b * c * c;
         }
         // lambda sum_{k<l} c_k^2 c_l^2 = lambda/2 ((sum c^2)^2 - sum c^4)
-        local[2] += geo.w[q] * 0.5 * m.lambda * (sum_sq * sum_sq - sum_4);
+        local[2] += w * 0.5 * m.lambda * (sum_sq * sum_sq - sum_4);
       }
     }
   });
@@ -345,7 +360,7 @@ double Assembly::compare_jacobians(const sp_step_data &d, const double *state, i
   agree_local(comm_, [&] {
     for (int e : my_elems_) {
       gather(e, d, state, g);
-      const int n = 8 * g.n_cells;
+      const int n = 2 * nen_ * g.n_cells;
       Ra.assign(n, 0.0); Rb.assign(n, 0.0);
       Ka.assign((size_t)n * n, 0.0); Kb.assign((size_t)n * n, 0.0);
       element_matrix(e, d, g, kind_a, Ra.data(), Ka.data());
@@ -372,20 +387,22 @@ void Assembly::shape_weights(const sp_step_data &d, std::vector<double> &u) cons
   std::vector<double> mine(2 * (size_t)n_pairs_, 0.0);
   agree_local(comm_, [&] {
     for (int e : my_elems_) {
-      const ElementGeometry &geo = geometry_[e];
+      const ElementGeometry geo = geometry(e);
       const int nc = n_cells_on(e);
       const int64_t s0 = elem_start_[e];
       for (int j = 0; j < nc; ++j) {
         const sp_shape_coef &sc = d.shape[slot_cell_[s0 + j]];
-        const int *pairs = &slot_pair_[4 * (s0 + j)];
-        for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
+        const int *pairs = &slot_pair_[nen_ * (s0 + j)];
+        for (int q = 0; q < nq_; ++q) {
+          const double *N = geo.N(q);
           double c_old = 0.0;
-          for (int a = 0; a < 4; ++a) c_old += geo.N[q][a] * d.state_old[2 * pairs[a]];
+          for (int a = 0; a < nen_; ++a) c_old += N[a] * d.state_old[2 * pairs[a]];
           if (c_old < sc.threshold) continue;  // the mask of element_residual
-          const double xb = geo.x[q][0] - sc.xc, yb = geo.x[q][1] - sc.yc;
+          // (the shape term is 2D only: scene.c refuses it on a 3D mesh)
+          const double xb = geo.x(q)[0] - sc.xc, yb = geo.x(q)[1] - sc.yc;
           for (int i = 0; i < 2; ++i) {
             const double ihat = shape_ihat(sc.v[i], xb, yb);
-            for (int a = 0; a < 4; ++a) mine[2 * pairs[a] + i] += geo.w[q] * geo.N[q][a] * ihat;
+            for (int a = 0; a < nen_; ++a) mine[2 * pairs[a] + i] += geo.w(q) * N[a] * ihat;
           }
         }
       }
@@ -402,7 +419,7 @@ void Assembly::element_pass(const sp_step_data &d, const double *state, int kind
   double sum = 0.0;  // read back so the work cannot be optimised away
   for (int e : my_elems_) {
     gather(e, d, state, g);
-    const int n = 8 * g.n_cells;
+    const int n = 2 * nen_ * g.n_cells;
     R.assign(n, 0.0);
     K.assign((size_t)n * n, 0.0);
     element_matrix(e, d, g, kind, R.data(), K.data());

@@ -59,6 +59,12 @@ class Assembly {
  private:
   struct Gathered;  // per-element scratch
   int n_cells_on(int e) const { return (int)(elem_start_[e + 1] - elem_start_[e]); }
+  // Element e's geometry (a view into geo_*).
+  ElementGeometry geometry(int e) const {
+    const size_t eq = (size_t)nq_ * e;
+    return ElementGeometry{dim_, nen_, nq_, &geo_N_[eq * nen_], &geo_dNdx_[eq * nen_ * dim_],
+                           &geo_x_[eq * dim_], &geo_w_[eq], geo_buffer_[e] != 0};
+  }
   void gather(int e, const sp_step_data &data, const double *state,
               Gathered &g) const;
   void element_matrix(int e, const sp_step_data &data, const Gathered &g,
@@ -66,14 +72,18 @@ class Assembly {
 
   const Epetra_Comm &comm_;
   int n_nodes_, n_pairs_, n_cells_;
+  // The mesh's element: dimension, nodes and Gauss points (q1.h).
+  int dim_, nen_, nq_;
   std::vector<int> node_start_, pair_cell_;
-  std::vector<ElementGeometry> geometry_;
+  // Every element's geometry at its Gauss points (ElementGeometry's layout).
+  std::vector<double> geo_N_, geo_dNdx_, geo_x_, geo_w_;
+  std::vector<char> geo_buffer_;
   std::vector<int> my_elems_;    // elements this rank assembles
   // The element-slot table (sp_layout_view): slots of element e are
-  // elem_start_[e]..elem_start_[e+1]-1, 64-bit as 4 x slots can pass 2^31.
+  // elem_start_[e]..elem_start_[e+1]-1, 64-bit as 8 x slots can pass 2^31.
   std::vector<int64_t> elem_start_;
   std::vector<int> slot_cell_;   // cell of each slot
-  std::vector<int> slot_pair_;   // 4 per slot: pair of (cell, node a)
+  std::vector<int> slot_pair_;   // nen_ per slot: pair of (cell, node a)
   std::unique_ptr<Epetra_Map> map_;
   std::unique_ptr<Epetra_CrsGraph> graph_;
 };

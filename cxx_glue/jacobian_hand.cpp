@@ -14,7 +14,9 @@
 //   dR_mu[k,a] / dc_l[b]  = -int N_a N_b 4 lambda c_k c_l     (l != k)
 //
 // and every other block is zero (coupled() in assembly.hpp). The pointwise
-// values and derivatives come from physics.hpp.
+// values and derivatives come from physics.hpp. Quadrilaterals and
+// hexahedra alike: the node and point counts are the element's, the local
+// arrays sized for the largest (q1.h).
 #include "jacobian_hand.hpp"
 
 #include <vector>
@@ -23,8 +25,8 @@ namespace sp {
 
 void hand_element(const ElementGeometry &g, int nc, const double *u,
                   const ElementInputs &in, double *R, double *K) {
-  constexpr int Q = SP_Q1_QPOINTS;
-  const int n = 8 * nc;
+  const int Q = g.qpoints, nen = g.nodes, dim = g.dim;
+  const int n = 2 * nen * nc;
   const sp_model_params &m = in.model;
   // Per quadrature point and slot: c (for the cross blocks) and the
   // coefficient of N_a N_b in the diagonal block dR_mu/dc.
@@ -33,43 +35,44 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
   double *cq = work.data(), *dq = cq + Q * nc;
 
   // w N_a N_b per point, and the element mass and stiffness matrices.
-  double NN[Q][4][4], Mab[4][4] = {}, Lab[4][4] = {};
+  constexpr int QM = SP_Q1_MAX_QPOINTS, NM = SP_Q1_MAX_NODES;
+  double NN[QM][NM][NM], Mab[NM][NM] = {}, Lab[NM][NM] = {};
   for (int q = 0; q < Q; ++q) {
-    const double w = g.w[q];
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b) {
-        NN[q][a][b] = w * g.N[q][a] * g.N[q][b];
+    const double w = g.w(q), *N = g.N(q);
+    for (int a = 0; a < nen; ++a)
+      for (int b = 0; b < nen; ++b) {
+        NN[q][a][b] = w * N[a] * N[b];
         Mab[a][b] += NN[q][a][b];
-        Lab[a][b] += w * (g.dNdx[q][a][0] * g.dNdx[q][b][0] +
-                          g.dNdx[q][a][1] * g.dNdx[q][b][1]);
+        Lab[a][b] += w * grad_dot(g.dNdx(q, a), g.dNdx(q, b), dim);
       }
   }
 
   // The residual, and the pointwise coefficients of the Jacobian.
   for (int i = 0; i < n; ++i) R[i] = 0.0;
   for (int q = 0; q < Q; ++q) {
-    const double *N = g.N[q];
-    const double w = g.w[q];
+    const double *N = g.N(q);
+    const double w = g.w(q);
     double sum_sq = 0.0;
     for (int j = 0; j < nc; ++j) {
       double c = 0.0;
-      for (int a = 0; a < 4; ++a) c += N[a] * u[(4 * j + a) * 2];
+      for (int a = 0; a < nen; ++a) c += N[a] * u[(nen * j + a) * 2];
       cq[q * nc + j] = c;
       sum_sq += c * c;
     }
     for (int j = 0; j < nc; ++j) {
       const double c = cq[q * nc + j];
-      double mu = 0.0, gc0 = 0.0, gc1 = 0.0, gmu0 = 0.0, gmu1 = 0.0;
+      double mu = 0.0, gc[SP_Q1_MAX_DIM] = {0, 0, 0}, gmu[SP_Q1_MAX_DIM] = {0, 0, 0};
       double c_old = 0.0, s = 0.0;
-      for (int a = 0; a < 4; ++a) {
-        const double ca = u[(4 * j + a) * 2], mua = u[(4 * j + a) * 2 + 1];
+      for (int a = 0; a < nen; ++a) {
+        const double ca = u[(nen * j + a) * 2], mua = u[(nen * j + a) * 2 + 1];
+        const double *dN = g.dNdx(q, a);
         mu += N[a] * mua;
-        gc0 += g.dNdx[q][a][0] * ca;
-        gc1 += g.dNdx[q][a][1] * ca;
-        gmu0 += g.dNdx[q][a][0] * mua;
-        gmu1 += g.dNdx[q][a][1] * mua;
-        c_old += N[a] * in.c_old[4 * j + a];
-        if (in.source) s += N[a] * in.source[4 * j + a];
+        for (int d = 0; d < dim; ++d) {
+          gc[d] += dN[d] * ca;
+          gmu[d] += dN[d] * mua;
+        }
+        c_old += N[a] * in.c_old[nen * j + a];
+        if (in.source) s += N[a] * in.source[nen * j + a];
       }
       double local = well_d1(m, c) + repulsion_d1(m, c, sum_sq);
       double d2 = well_d2(m, c) + repulsion_d2_self(m, c, sum_sq);
@@ -78,13 +81,13 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
         d2 += buffer_d2(m);
       }
       if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
-        local += shape_mu(*in.shape[j], g.x[q][0], g.x[q][1]);
+        local += shape_mu(*in.shape[j], g.x(q)[0], g.x(q)[1]);  // 2D only (scene.c)
       dq[q * nc + j] = d2;
       const double rate = c - c_old - in.dt * s;
-      for (int a = 0; a < 4; ++a) {
-        const double *dN = g.dNdx[q][a];
-        R[(4 * j + a) * 2] += w * (N[a] * rate + in.dt * m.mobility * (dN[0] * gmu0 + dN[1] * gmu1));
-        R[(4 * j + a) * 2 + 1] += w * (N[a] * (mu - local) - m.kappa * (dN[0] * gc0 + dN[1] * gc1));
+      for (int a = 0; a < nen; ++a) {
+        const double *dN = g.dNdx(q, a);
+        R[(nen * j + a) * 2] += w * (N[a] * rate + in.dt * m.mobility * grad_dot(dN, gmu, dim));
+        R[(nen * j + a) * 2 + 1] += w * (N[a] * (mu - local) - m.kappa * grad_dot(dN, gc, dim));
       }
     }
   }
@@ -92,12 +95,12 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
   // Diagonal (own-cell) blocks.
   const double dtM = in.dt * m.mobility;
   for (int j = 0; j < nc; ++j) {
-    double d[Q];
+    double d[QM];
     for (int q = 0; q < Q; ++q) d[q] = dq[q * nc + j];
-    for (int a = 0; a < 4; ++a) {
-      double *Kc = K + (size_t)((4 * j + a) * 2) * n + 8 * j;  // row c, cols of slot j
-      double *Km = Kc + n;                                      // row mu
-      for (int b = 0; b < 4; ++b) {
+    for (int a = 0; a < nen; ++a) {
+      double *Kc = K + (size_t)((nen * j + a) * 2) * n + 2 * nen * j;  // row c, cols of slot j
+      double *Km = Kc + n;                                              // row mu
+      for (int b = 0; b < nen; ++b) {
         double nl = 0.0;
         for (int q = 0; q < Q; ++q) nl += d[q] * NN[q][a][b];
         Kc[2 * b] = Mab[a][b];
@@ -111,13 +114,13 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
   // Cross-cell blocks dR_mu[j]/dc_l = dR_mu[l]/dc_j: once per unordered pair.
   for (int j = 0; j < nc; ++j)
     for (int l = j + 1; l < nc; ++l) {
-      double d[Q];
+      double d[QM];
       for (int q = 0; q < Q; ++q)
         d[q] = repulsion_d2_cross(m, cq[q * nc + j], cq[q * nc + l]);
-      for (int a = 0; a < 4; ++a) {
-        double *Kjl = K + (size_t)((4 * j + a) * 2 + 1) * n + 8 * l;  // row mu_j, cols c_l
-        double *Klj = K + (size_t)((4 * l + a) * 2 + 1) * n + 8 * j;  // row mu_l, cols c_j
-        for (int b = 0; b < 4; ++b) {
+      for (int a = 0; a < nen; ++a) {
+        double *Kjl = K + (size_t)((nen * j + a) * 2 + 1) * n + 2 * nen * l;  // row mu_j, cols c_l
+        double *Klj = K + (size_t)((nen * l + a) * 2 + 1) * n + 2 * nen * j;  // row mu_l, cols c_j
+        for (int b = 0; b < nen; ++b) {
           double v = 0.0;
           for (int q = 0; q < Q; ++q) v += d[q] * NN[q][a][b];
           Kjl[2 * b] = -v;

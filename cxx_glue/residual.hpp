@@ -2,8 +2,13 @@
 // "Dynamics"), templated on the scalar type so one code gives residuals
 // (double) and AD Jacobians (Sacado Fad).
 //
+// One code for quadrilaterals and hexahedra: the element's node count n
+// (4 or 8), point count and dimension are read at run time from its
+// geometry (q1.h's reference elements), with loops over them; see
+// docs/design.md for why not templates on the element type.
+//
 // Element unknowns, for the n_cells cells present on the element: slot j,
-// local node a, field f (0 = c, 1 = mu) at index (4 j + a) 2 + f.
+// local node a, field f (0 = c, 1 = mu) at index (n j + a) 2 + f.
 // Per slot and node, the residual rows are:
 //   R_c  = int N_a (c - c_old) + dt M grad N_a . grad mu - dt N_a s
 //   R_mu = int N_a mu - N_a [f'(c) + 2 lambda c sum_{l!=k} c_l^2
@@ -19,19 +24,34 @@
 
 namespace sp {
 
-// Geometry of one element at its 4 Gauss points, computed once per mesh.
+// Geometry of one element at its Gauss points, computed once per mesh: a
+// view into the mesh's arrays (Assembly), sized by the element's dimension,
+// nodes and points, so a 2D mesh keeps no 3D-sized storage.
 struct ElementGeometry {
-  double N[SP_Q1_QPOINTS][4];
-  double dNdx[SP_Q1_QPOINTS][4][2];
-  double x[SP_Q1_QPOINTS][2];
-  double w[SP_Q1_QPOINTS];
+  int dim, nodes, qpoints;
+  const double *N_;     // [q nodes + a]
+  const double *dNdx_;  // [(q nodes + a) dim + d]
+  const double *x_;     // [q dim + d]
+  const double *w_;     // [q]
   bool buffer;
+  const double *N(int q) const { return N_ + q * nodes; }           // N(q)[a]
+  const double *dNdx(int q, int a) const { return dNdx_ + (q * nodes + a) * dim; }
+  const double *x(int q) const { return x_ + q * dim; }
+  double w(int q) const { return w_[q]; }
 };
+
+// a . b for vectors of the element's dimension: a[0] b[0] + a[1] b[1]
+// (+ a[2] b[2]), in that order (doubles: the hand Jacobian, energies).
+inline double grad_dot(const double *a, const double *b, int dim) {
+  double s = a[0] * b[0];
+  for (int d = 1; d < dim; ++d) s += a[d] * b[d];
+  return s;
+}
 
 // Per-step data an element reads besides its unknowns.
 struct ElementInputs {
-  const double *c_old;   // 4 n_cells nodal c^n (slot-major)
-  const double *source;  // 4 n_cells nodal s_k (slot-major), or nullptr
+  const double *c_old;   // nodes x n_cells nodal c^n (slot-major)
+  const double *source;  // nodes x n_cells nodal s_k (slot-major), or nullptr
   const sp_shape_coef *const *shape;  // n_cells entries or nullptr
   double dt;
   sp_model_params model;
@@ -40,48 +60,62 @@ struct ElementInputs {
 template <class S>
 void element_residual(const ElementGeometry &g, int n_cells, const S *u,
                       const ElementInputs &in, S *R) {
-  const int n = 8 * n_cells;
+  const int nen = g.nodes, dim = g.dim;
+  const int n = 2 * nen * n_cells;
   for (int i = 0; i < n; ++i) R[i] = 0.0;
   const sp_model_params &m = in.model;
   // Per-slot values at one quadrature point.
-  std::vector<S> c(n_cells), mu(n_cells), gc(2 * n_cells), gmu(2 * n_cells);
-  for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-    const double *N = g.N[q];
+  std::vector<S> c(n_cells), mu(n_cells), gc(dim * n_cells), gmu(dim * n_cells);
+  for (int q = 0; q < g.qpoints; ++q) {
+    const double *N = g.N(q);
     S sum_sq = 0.0;
     for (int j = 0; j < n_cells; ++j) {
       c[j] = 0.0; mu[j] = 0.0;
-      gc[2 * j] = 0.0; gc[2 * j + 1] = 0.0;
-      gmu[2 * j] = 0.0; gmu[2 * j + 1] = 0.0;
-      for (int a = 0; a < 4; ++a) {
-        const S &ca = u[(4 * j + a) * 2], &mua = u[(4 * j + a) * 2 + 1];
+      for (int d = 0; d < dim; ++d) {
+        gc[dim * j + d] = 0.0;
+        gmu[dim * j + d] = 0.0;
+      }
+      for (int a = 0; a < nen; ++a) {
+        const S &ca = u[(nen * j + a) * 2], &mua = u[(nen * j + a) * 2 + 1];
+        const double *dN = g.dNdx(q, a);
         c[j] += N[a] * ca;
         mu[j] += N[a] * mua;
-        for (int d = 0; d < 2; ++d) {
-          gc[2 * j + d] += g.dNdx[q][a][d] * ca;
-          gmu[2 * j + d] += g.dNdx[q][a][d] * mua;
+        for (int d = 0; d < dim; ++d) {
+          gc[dim * j + d] += dN[d] * ca;
+          gmu[dim * j + d] += dN[d] * mua;
         }
       }
       sum_sq += c[j] * c[j];
     }
-    const double w = g.w[q];
+    const double w = g.w(q);
     for (int j = 0; j < n_cells; ++j) {
       double c_old = 0.0, s = 0.0;
-      for (int a = 0; a < 4; ++a) {
-        c_old += N[a] * in.c_old[4 * j + a];
-        if (in.source) s += N[a] * in.source[4 * j + a];
+      for (int a = 0; a < nen; ++a) {
+        c_old += N[a] * in.c_old[nen * j + a];
+        if (in.source) s += N[a] * in.source[nen * j + a];
       }
       // Everything in mu_k that is not the Laplacian: f', pairs, buffer, shape.
       S local = well_d1(m, c[j]) + repulsion_d1(m, c[j], sum_sq);
       if (g.buffer) local += buffer_d1(m, c[j]);
       if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
-        local += shape_mu(*in.shape[j], g.x[q][0], g.x[q][1]);
+        local += shape_mu(*in.shape[j], g.x(q)[0], g.x(q)[1]);  // 2D only (scene.c)
       const S rate = c[j] - c_old - in.dt * s;
-      for (int a = 0; a < 4; ++a) {
-        const double *dN = g.dNdx[q][a];
-        R[(4 * j + a) * 2] += w * (N[a] * rate + in.dt * m.mobility *
-                                   (dN[0] * gmu[2 * j] + dN[1] * gmu[2 * j + 1]));
-        R[(4 * j + a) * 2 + 1] += w * (N[a] * (mu[j] - local) - m.kappa *
-                                       (dN[0] * gc[2 * j] + dN[1] * gc[2 * j + 1]));
+      const S *gm = &gmu[dim * j], *gcj = &gc[dim * j];
+      for (int a = 0; a < nen; ++a) {
+        // grad N_a . grad mu and grad N_a . grad c written out per dimension
+        // (a loop would store each in a Fad temporary: a copy, or with DFad
+        // an allocation, per node and point)
+        const double *dN = g.dNdx(q, a);
+        S &Rc = R[(nen * j + a) * 2], &Rmu = R[(nen * j + a) * 2 + 1];
+        if (dim == 2) {
+          Rc += w * (N[a] * rate + in.dt * m.mobility * (dN[0] * gm[0] + dN[1] * gm[1]));
+          Rmu += w * (N[a] * (mu[j] - local) - m.kappa * (dN[0] * gcj[0] + dN[1] * gcj[1]));
+        } else {
+          Rc += w * (N[a] * rate + in.dt * m.mobility *
+                                       (dN[0] * gm[0] + dN[1] * gm[1] + dN[2] * gm[2]));
+          Rmu += w * (N[a] * (mu[j] - local) -
+                      m.kappa * (dN[0] * gcj[0] + dN[1] * gcj[1] + dN[2] * gcj[2]));
+        }
       }
     }
   }

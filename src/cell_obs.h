@@ -16,14 +16,19 @@ typedef struct {
   double mass_core; /**< int c_k dV over c_k >= weight_threshold only: the
                          cell without its background (division, source) */
   double xc, yc;    /**< centre of mass int c X / int c */
+  double zc;        /**< its z on a 3D mesh (0 in 2D) */
   double Ixx, Iyy, Ixy; /**< inertia tensor [[Ixx, Ixy],[Ixy, Iyy]] about
                              the centre: Ixx = int c Xb2^2, Iyy = int c Xb1^2,
-                             Ixy = -int c Xb1 Xb2 */
+                             Ixy = -int c Xb1 Xb2; 2D only (on a 3D mesh
+                             this and the moments, eigenvectors and angle
+                             below are zero, v1 and v2 the x and y axes,
+                             until issue 29's 3x3 tensor) */
   double I1, I2;    /**< principal moments, I1 >= I2 */
   double v1[2], v2[2]; /**< unit eigenvectors of I1 and I2 */
   double angle;     /**< angle of v1 from the x axis, in (-pi/2, pi/2] */
-  double area;      /**< area where c_k >= 1/2 (inside the membrane; at the
-                         quadrature points, whatever the weight threshold) */
+  double area;      /**< area (3D: volume) where c_k >= 1/2 (inside the
+                         membrane; at the quadrature points, whatever the
+                         weight threshold) */
 } sp_cell_obs;
 
 #ifdef __cplusplus

@@ -32,12 +32,12 @@ void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
 }
 
 /** The shape functions at the Gauss points, N[q][b] (the same on every
- *  element: Q1's reference values). */
-static void reference_shapes(double N[SP_Q1_QPOINTS][4]) {
-  for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-    double xi, eta, dN[4][2];
-    sp_q1_qpoint(q, &xi, &eta);
-    sp_q1_shape(xi, eta, N[q], dN);
+ *  element: Q1's reference values in dimension @p dim). */
+static void reference_shapes(int dim, double N[SP_Q1_MAX_QPOINTS][SP_Q1_MAX_NODES]) {
+  for (int q = 0; q < sp_q1_qpoints(dim); ++q) {
+    double xi[SP_Q1_MAX_DIM], dN[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+    sp_q1_qpoint(dim, q, xi);
+    sp_q1_shape(dim, xi, N[q], dN);
   }
 }
 
@@ -54,17 +54,18 @@ int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, d
            layout->n_cells);
   const sp_slots *t;
   SP_CALL(elements_of(mesh, layout, &t));
-  double N[SP_Q1_QPOINTS][4];
-  reference_shapes(N);
+  const int nen = mesh->nodes_per_elem, nq = sp_q1_qpoints(mesh->dim);
+  double N[SP_Q1_MAX_QPOINTS][SP_Q1_MAX_NODES];
+  reference_shapes(mesh->dim, N);
   for (int i = 0; i < mesh->n_nodes; ++i) w[i] = 0.0;
   for (int e = 0; e < mesh->n_elems; ++e) {
-    const int *nodes = mesh->elem + 4 * e;
+    const int *nodes = mesh->elem + (size_t)nen * e;
     int64_t s = t->elem_start[e]; /* slots by increasing cell */
     while (s < t->elem_start[e + 1] && t->slot_cell[s] < k) ++s;
     if (s == t->elem_start[e + 1] || t->slot_cell[s] != k) continue;
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      const double wq = mesh->q1_w[SP_Q1_QPOINTS * (size_t)e + q];
-      for (int b = 0; b < 4; ++b) w[nodes[b]] += wq * N[q][b];
+    for (int q = 0; q < nq; ++q) {
+      const double wq = mesh->q1_w[(size_t)nq * e + q];
+      for (int b = 0; b < nen; ++b) w[nodes[b]] += wq * N[q][b];
     }
   }
   return SP_OK;
@@ -73,15 +74,16 @@ int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, d
 int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *w) {
   const sp_slots *t;
   SP_CALL(elements_of(mesh, layout, &t));
-  double N[SP_Q1_QPOINTS][4];
-  reference_shapes(N);
+  const int nen = mesh->nodes_per_elem, nq = sp_q1_qpoints(mesh->dim);
+  double N[SP_Q1_MAX_QPOINTS][SP_Q1_MAX_NODES];
+  reference_shapes(mesh->dim, N);
   for (int p = 0; p < layout->n_pairs; ++p) w[p] = 0.0;
   for (int e = 0; e < mesh->n_elems; ++e)
     for (int64_t s = t->elem_start[e]; s < t->elem_start[e + 1]; ++s) {
-      const int *pairs = t->slot_pair + 4 * (size_t)s;
-      for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-        const double wq = mesh->q1_w[SP_Q1_QPOINTS * (size_t)e + q];
-        for (int b = 0; b < 4; ++b) w[pairs[b]] += wq * N[q][b];
+      const int *pairs = t->slot_pair + (size_t)nen * s;
+      for (int q = 0; q < nq; ++q) {
+        const double wq = mesh->q1_w[(size_t)nq * e + q];
+        for (int b = 0; b < nen; ++b) w[pairs[b]] += wq * N[q][b];
       }
     }
   return SP_OK;
@@ -93,27 +95,35 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
   const int nc = layout->n_cells;
   const sp_slots *t;
   SP_CALL(elements_of(mesh, layout, &t));
-  double N[SP_Q1_QPOINTS][4];
-  reference_shapes(N);
-  /* Per cell: mass, weighted mass, first and second moments, area. */
+  const int dim = mesh->dim, nen = mesh->nodes_per_elem, nq = sp_q1_qpoints(dim);
+  double N[SP_Q1_MAX_QPOINTS][SP_Q1_MAX_NODES];
+  reference_shapes(dim, N);
+  /* Per cell: mass, weighted mass, first and second moments (x, y), the
+   * area (2D) or volume (3D) inside the membrane, and the first moment in
+   * z (3D). */
+  enum { SUMS = 9 };
   double *sums;
-  SP_ALLOC(sums, 8 * (size_t)nc);
+  SP_ALLOC(sums, SUMS * (size_t)nc);
   for (int e = 0; e < mesh->n_elems; ++e) {
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      const size_t eq = SP_Q1_QPOINTS * (size_t)e + q;
-      const double w = mesh->q1_w[eq], *x = mesh->q1_x + 2 * eq;
+    for (int q = 0; q < nq; ++q) {
+      const size_t eq = (size_t)nq * e + q;
+      const double w = mesh->q1_w[eq], *x = mesh->q1_x + (size_t)dim * eq;
       /* the cells living on the element (the slot table's rule) */
       for (int64_t slot = t->elem_start[e]; slot < t->elem_start[e + 1]; ++slot) {
-        const int *pairs = t->slot_pair + 4 * (size_t)slot;
+        const int *pairs = t->slot_pair + (size_t)nen * slot;
         double c = 0;
-        for (int b = 0; b < 4; ++b) c += N[q][b] * state[2 * pairs[b]];
-        double *s = sums + 8 * t->slot_cell[slot];
+        for (int b = 0; b < nen; ++b) c += N[q][b] * state[2 * pairs[b]];
+        double *s = sums + SUMS * t->slot_cell[slot];
         s[0] += w * c;
         if (c >= 0.5) s[7] += w;
         const double cw = c >= weight_threshold ? c : 0.0;
         s[1] += w * cw;
         s[2] += w * cw * x[0];
         s[3] += w * cw * x[1];
+        if (dim == 3) {
+          s[8] += w * cw * x[2];
+          continue; /* the inertia tensor in 3D: issue 29's next phase */
+        }
         s[4] += w * cw * x[0] * x[0];
         s[5] += w * cw * x[1] * x[1];
         s[6] += w * cw * x[0] * x[1];
@@ -121,7 +131,7 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
     }
   }
   for (int k = 0; k < nc; ++k) {
-    const double *s = sums + 8 * k;
+    const double *s = sums + SUMS * k;
     sp_cell_obs *o = obs + k;
     o->mass = s[0];
     o->area = s[7];
@@ -129,6 +139,12 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
     const double m = s[1] > 0 ? s[1] : 1.0;
     o->xc = s[2] / m;
     o->yc = s[3] / m;
+    o->zc = dim == 3 ? s[8] / m : 0.0;
+    if (dim == 3) { /* no moments yet in 3D: zero, and v1, v2 the x and y axes */
+      *o = (sp_cell_obs){.mass = o->mass, .mass_core = o->mass_core, .area = o->area,
+                         .xc = o->xc, .yc = o->yc, .zc = o->zc, .v1 = {1, 0}, .v2 = {0, 1}};
+      continue;
+    }
     /* Central moments: int c Xb1^2 = int c x^2 - m xc^2, etc. */
     const double xx = s[4] - m * o->xc * o->xc;
     const double yy = s[5] - m * o->yc * o->yc;
@@ -170,7 +186,7 @@ int sp_cells_fill(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *l
       const double xi = noise->amplitude > 0 ? sp_random_symmetric(&rng) : 0.0;
       const int p = sp_layout_pair(layout, k, i);
       if (p < 0) continue;
-      const double profile = profile_of(k, mesh->xy[2 * i], mesh->xy[2 * i + 1], ctx);
+      const double profile = profile_of(k, mesh->xy + (size_t)mesh->dim * i, mesh->dim, ctx);
       state[2 * p] = profile + (1.0 - profile) * (noise->background + noise->amplitude * xi);
       state[2 * p + 1] = 0.0;
     }
@@ -178,11 +194,13 @@ int sp_cells_fill(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *l
   return SP_OK;
 }
 
-/** The scene's cell k: a disk with the tanh profile of width d, or sharp. */
-static double disk_profile(int k, double x, double y, void *ctx) {
+/** The scene's cell k: a disk (2D) or a sphere (3D: its z given) with the
+ *  tanh profile of width d, or sharp. */
+static double disk_profile(int k, const double *x, int dim, void *ctx) {
   const sp_scene *scene = ctx;
   const sp_scene_cell *cell = &scene->cells[k];
-  const double r = hypot(x - cell->x, y - cell->y);
+  (void)dim; /* the scene's disks (2D) */
+  const double r = hypot(x[0] - cell->x, x[1] - cell->y);
   if (cell->profile == SP_PROFILE_SHARP) return r <= cell->radius ? 1.0 : 0.0;
   return sp_cells_profile(r - cell->radius, sp_scene_interface_width(scene));
 }

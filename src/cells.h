@@ -71,8 +71,8 @@ double sp_random_symmetric(unsigned long long *rng);
  *  distance @p signed_distance from it (> 0 outside): 1 / (1 + e^(s/d)). */
 double sp_cells_profile(double signed_distance, double d);
 
-/** Cell k's profile (c without noise, in [0, 1]) at (x, y). */
-typedef double (*sp_profile_fn)(int k, double x, double y, void *ctx);
+/** Cell k's profile (c without noise, in [0, 1]) at the point x[0..dim). */
+typedef double (*sp_profile_fn)(int k, const double *x, int dim, void *ctx);
 
 /** @brief The initial state of every cell of @p layout from @p profile_of,
  *         with the scene's noise outside the cells (mu = 0). */

@@ -174,7 +174,9 @@ typedef struct {
   double d;   /* interface width */
 } sp_label_fields;
 
-static double label_profile(int k, double x, double y, void *ctx) {
+static double label_profile(int k, const double *point, int dim, void *ctx) {
+  (void)dim; /* a 2D label image (3D scenes refuse one: scene.c) */
+  const double x = point[0], y = point[1];
   const sp_label_fields *lf = ctx;
   const sp_scene_initial *b = lf->box;
   const int w = lf->width, h = lf->height;

@@ -180,26 +180,29 @@ static int slots_build(const sp_layout *l, const sp_mesh *m, sp_slots **out) {
   sp_slots *t;
   SP_ALLOC(t, 1);
   *out = t;
+  const int nen = m->nodes_per_elem;
   t->n_elems = m->n_elems;
+  t->nodes_per_elem = nen;
   /* At most one slot per pair of an element's first node. */
   int64_t bound = 0;
   for (int e = 0; e < m->n_elems; ++e) {
-    const int n0 = m->elem[4 * e];
+    const int n0 = m->elem[(size_t)nen * e];
     bound += l->node_start[n0 + 1] - l->node_start[n0];
   }
   SP_ALLOC(t->elem_start, (size_t)m->n_elems + 1);
   SP_ALLOC(t->slot_cell, (size_t)bound);
-  SP_ALLOC(t->slot_pair, 4 * (size_t)bound);
+  SP_ALLOC(t->slot_pair, (size_t)nen * (size_t)bound);
   int64_t s = 0;
   for (int e = 0; e < m->n_elems; ++e) {
-    const int *nodes = m->elem + 4 * e;
+    const int *nodes = m->elem + (size_t)nen * e;
     t->elem_start[e] = s;
-    /* Cell k lives on element e only if all four nodes carry it. */
+    /* Cell k lives on element e only if all its nodes carry it. */
     for (int p0 = l->node_start[nodes[0]]; p0 < l->node_start[nodes[0] + 1]; ++p0) {
       const int k = l->pair_cell[p0];
-      int *pairs = t->slot_pair + 4 * (size_t)s, whole = 1;
+      int *pairs = t->slot_pair + (size_t)nen * (size_t)s, whole = 1;
       pairs[0] = p0;
-      for (int a = 1; a < 4 && whole; ++a) whole = (pairs[a] = sp_layout_pair(l, k, nodes[a])) >= 0;
+      for (int a = 1; a < nen && whole; ++a)
+        whole = (pairs[a] = sp_layout_pair(l, k, nodes[a])) >= 0;
       if (whole) t->slot_cell[s++] = k;
     }
   }
@@ -279,9 +282,9 @@ void sp_layout_destroy(sp_layout **layout) {
   *layout = NULL;
 }
 
-long long sp_layout_nonzeros_bound(const sp_layout *layout) {
+long long sp_layout_nonzeros_bound(const sp_layout *layout, int dim) {
   long long bound = 0;
   for (int i = 0; i < layout->n_nodes; ++i)
-    bound += sp_nonzeros_bound(1, layout->node_start[i + 1] - layout->node_start[i]);
+    bound += sp_nonzeros_bound(dim, 1, layout->node_start[i + 1] - layout->node_start[i]);
   return bound;
 }

@@ -30,15 +30,16 @@ extern "C" {
  *  counts), and the serial backends gather every row on one process. */
 #define SP_LAYOUT_MAX_NONZEROS ((long long)INT_MAX)
 
-/** An upper bound of the Jacobian's nonzeros on a layout whose node i
- *  carries n_i cells: a cell lives on an element only if all four nodes
- *  carry it, so every cell coupled to (k, i) is at node i too; the c row of
- *  (k, i) has at most 9 x 2 entries (c_k and mu_k at i and its 8
- *  neighbours), the mu row at most 9 x (n_i + 1) (c_k, mu_k and the other
- *  cells' c): sum over nodes of 9 n_i (n_i + 3). Exact inside a full
- *  layout of a structured mesh; an overestimate at boundaries. */
-static inline long long sp_nonzeros_bound(long long n_nodes, long long n_i) {
-  return 9 * n_nodes * n_i * (n_i + 3);
+/** An upper bound of the Jacobian's nonzeros on a layout of a mesh of
+ *  dimension @p dim whose node i carries n_i cells: a cell lives on an
+ *  element only if all its nodes carry it, so every cell coupled to (k, i)
+ *  is at node i too; with g = 3^dim (9 in 2D, 27 in 3D: node i and its
+ *  neighbours on a structured mesh), the c row of (k, i) has at most g x 2
+ *  entries (c_k and mu_k), the mu row at most g x (n_i + 1) (c_k, mu_k and
+ *  the other cells' c): sum over nodes of g n_i (n_i + 3). Exact inside a
+ *  full layout of a structured mesh; an overestimate at boundaries. */
+static inline long long sp_nonzeros_bound(int dim, long long n_nodes, long long n_i) {
+  return (dim == 3 ? 27 : 9) * n_nodes * n_i * (n_i + 3);
 }
 
 struct sp_mesh;
@@ -57,20 +58,22 @@ typedef struct sp_layout {
 
 /**
  * The element-slot table of a layout on a mesh: the one place where the
- * rule "cell k lives on element e only if all four of its nodes carry k"
+ * rule "cell k lives on element e only if all the element's nodes carry k"
  * is applied (a field's domain is then a union of whole elements, with a
  * natural no-flux boundary). CSR by element: element e's slots are
  * elem_start[e] .. elem_start[e+1]-1, by increasing cell; slot s is cell
  * slot_cell[s] on the element, with the pair of its local node a at
- * slot_pair[4 s + a] (never -1). Offsets are 64-bit: slots x 4 can pass
- * 2^31 where pairs cannot.
+ * slot_pair[nodes_per_elem s + a] (never -1); nodes_per_elem is the
+ * mesh's (4 or 8). Offsets are 64-bit: slots x 8 can pass 2^31 where
+ * pairs cannot.
  */
 typedef struct sp_slots {
   int n_elems;
+  int nodes_per_elem;  /**< the mesh's: 4 (quadrilaterals) or 8 (hexahedra) */
   int64_t n_slots;
   int64_t *elem_start; /**< n_elems + 1 */
   int *slot_cell;      /**< n_slots */
-  int *slot_pair;      /**< 4 n_slots */
+  int *slot_pair;      /**< nodes_per_elem n_slots */
 } sp_slots;
 
 /**
@@ -98,8 +101,9 @@ int sp_layout_create_from_masks(int n_nodes, int n_cells,
                                 const unsigned char *in_support,
                                 sp_layout **out);
 
-/** @brief sp_nonzeros_bound summed over the layout's nodes. */
-long long sp_layout_nonzeros_bound(const sp_layout *layout);
+/** @brief sp_nonzeros_bound summed over the layout's nodes (a mesh of
+ *         dimension @p dim). */
+long long sp_layout_nonzeros_bound(const sp_layout *layout, int dim);
 
 /**
  * @brief A layout from per-cell node lists: cell k's support is the nodes

@@ -1,7 +1,8 @@
 /**
  * @file mesh.c
- * @brief Rectangle meshes and the paper's five-patch disk mapped to an
- *        ellipse (MODEL.md, "Mesh of the paper's runs" and "Buffer zone").
+ * @brief Rectangle meshes, the paper's five-patch disk mapped to an
+ *        ellipse (MODEL.md, "Mesh of the paper's runs" and "Buffer zone"),
+ *        and hexahedral boxes (3D, issue 29).
  *
  * The five-patch disk of refinement r has n = 2^r elements along every patch
  * side: an n x n centre square and four n x n patches between the square's
@@ -55,17 +56,20 @@
 /* Shared helpers                                                           */
 /* ------------------------------------------------------------------------ */
 
-/** Allocate the arrays of a mesh with the given counts. */
-static int mesh_allocate(int n_nodes, int n_elems, sp_mesh **out) {
+/** Allocate the arrays of a mesh of dimension @p dim with the given counts. */
+static int mesh_allocate(int dim, int n_nodes, int n_elems, sp_mesh **out) {
   sp_mesh *mesh;
   SP_ALLOC(mesh, 1);
+  const size_t nq = (size_t)sp_q1_qpoints(dim);
   mesh->n_nodes = n_nodes;
   mesh->n_elems = n_elems;
-  mesh->xy = calloc((size_t)2 * n_nodes, sizeof *mesh->xy);
-  mesh->elem = calloc((size_t)4 * n_elems, sizeof *mesh->elem);
+  mesh->dim = dim;
+  mesh->nodes_per_elem = sp_q1_nodes(dim);
+  mesh->xy = calloc((size_t)dim * n_nodes, sizeof *mesh->xy);
+  mesh->elem = calloc((size_t)mesh->nodes_per_elem * n_elems, sizeof *mesh->elem);
   mesh->region = calloc((size_t)n_elems, sizeof *mesh->region);
-  mesh->q1_w = calloc((size_t)SP_Q1_QPOINTS * n_elems, sizeof *mesh->q1_w);
-  mesh->q1_x = calloc((size_t)2 * SP_Q1_QPOINTS * n_elems, sizeof *mesh->q1_x);
+  mesh->q1_w = calloc(nq * n_elems, sizeof *mesh->q1_w);
+  mesh->q1_x = calloc((size_t)dim * nq * n_elems, sizeof *mesh->q1_x);
   if (!mesh->xy || !mesh->elem || !mesh->region || !mesh->q1_w || !mesh->q1_x) {
     sp_mesh_destroy(&mesh);
     return sp_error_set(SP_ERR_MEMORY, "out of memory allocating a mesh of "
@@ -78,19 +82,25 @@ static int mesh_allocate(int n_nodes, int n_elems, sp_mesh **out) {
 /** The largest element edge length (sets mesh->h) and the Q1 geometry at
  *  the Gauss points (mesh->q1_w, q1_x), once the nodes are final. */
 static void mesh_finish(sp_mesh *mesh) {
+  /* The edges of an element (q1.h's node order): each face ring 0-1-2-3
+   * (and 4-5-6-7 in 3D), and in 3D the edges a -> a + 4 between them. */
+  static const int edge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+                                  {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+  const int dim = mesh->dim, nq = sp_q1_qpoints(dim), n_edges = dim == 3 ? 12 : 4;
   double h2 = 0;
   for (int e = 0; e < mesh->n_elems; ++e) {
-    double xy[4][2];
-    sp_mesh_elem_xy(mesh, e, xy);
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      const size_t eq = (size_t)SP_Q1_QPOINTS * e + q;
-      double N[4], dNdx[4][2];
-      sp_q1_point(xy, q, N, dNdx, mesh->q1_x + 2 * eq, mesh->q1_w + eq);
+    double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+    sp_mesh_elem_xy(mesh, e, xe);
+    for (int q = 0; q < nq; ++q) {
+      const size_t eq = (size_t)nq * e + q;
+      double N[SP_Q1_MAX_NODES], dNdx[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+      sp_q1_point(dim, xe, q, N, dNdx, mesh->q1_x + (size_t)dim * eq, mesh->q1_w + eq);
     }
-    for (int a = 0; a < 4; ++a) {
-      double dx = xy[(a + 1) % 4][0] - xy[a][0];
-      double dy = xy[(a + 1) % 4][1] - xy[a][1];
-      if (dx * dx + dy * dy > h2) h2 = dx * dx + dy * dy;
+    for (int k = 0; k < n_edges; ++k) {
+      const int a = edge[k][0], b = edge[k][1];
+      double length2 = 0;
+      for (int d = 0; d < dim; ++d) length2 += (xe[b][d] - xe[a][d]) * (xe[b][d] - xe[a][d]);
+      if (length2 > h2) h2 = length2;
     }
   }
   mesh->h = sqrt(h2);
@@ -125,7 +135,7 @@ int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
            "mesh: nx x ny = %d x %d is too large", nx, ny);
 
   sp_mesh *mesh;
-  SP_CALL(mesh_allocate((int)sp_mesh_rectangle_nodes(nx, ny), nx * ny, &mesh));
+  SP_CALL(mesh_allocate(2, (int)sp_mesh_rectangle_nodes(nx, ny), nx * ny, &mesh));
   /* Nodes row by row, i fastest: node (i, j) = j (nx+1) + i. */
   for (int j = 0; j <= ny; ++j)
     for (int i = 0; i <= nx; ++i) {
@@ -147,6 +157,61 @@ int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
   mesh->bounds[1] = y0;
   mesh->bounds[2] = x1;
   mesh->bounds[3] = y1;
+  mesh_finish(mesh);
+  *out = mesh;
+  return SP_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Box (3D)                                                                 */
+/* ------------------------------------------------------------------------ */
+
+long long sp_mesh_box_nodes(int nx, int ny, int nz) {
+  return ((long long)nx + 1) * ((long long)ny + 1) * ((long long)nz + 1);
+}
+
+int sp_mesh_box(double x0, double y0, double z0, double x1, double y1, double z1, int nx,
+                int ny, int nz, sp_mesh **out) {
+  SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_box: out is NULL");
+  *out = NULL;
+  SP_CHECK(nx >= 1, SP_ERR_INPUT, "mesh: nx must be >= 1, got %d", nx);
+  SP_CHECK(ny >= 1, SP_ERR_INPUT, "mesh: ny must be >= 1, got %d", ny);
+  SP_CHECK(nz >= 1, SP_ERR_INPUT, "mesh: nz must be >= 1, got %d", nz);
+  SP_CHECK(isfinite(x0) && isfinite(x1) && x1 > x0, SP_ERR_INPUT,
+           "mesh: need x0 < x1 (finite), got x0 = %g, x1 = %g", x0, x1);
+  SP_CHECK(isfinite(y0) && isfinite(y1) && y1 > y0, SP_ERR_INPUT,
+           "mesh: need y0 < y1 (finite), got y0 = %g, y1 = %g", y0, y1);
+  SP_CHECK(isfinite(z0) && isfinite(z1) && z1 > z0, SP_ERR_INPUT,
+           "mesh: need z0 < z1 (finite), got z0 = %g, z1 = %g", z0, z1);
+  /* the nodes, and 8 nx ny nz element entries, must fit an int */
+  SP_CHECK(sp_mesh_box_nodes(nx, ny, nz) < INT_MAX / 8, SP_ERR_INPUT,
+           "mesh: nx x ny x nz = %d x %d x %d is too large", nx, ny, nz);
+
+  sp_mesh *mesh;
+  SP_CALL(mesh_allocate(3, (int)sp_mesh_box_nodes(nx, ny, nz), nx * ny * nz, &mesh));
+  /* node (i, j, k) = (k (ny+1) + j) (nx+1) + i */
+  const int sx = 1, sy = nx + 1, sz = (nx + 1) * (ny + 1);
+  for (int k = 0; k <= nz; ++k)
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) {
+        const int node = k * sz + j * sy + i;
+        mesh->xy[3 * node] = lerp_exact_ends(x0, x1, i, nx);
+        mesh->xy[3 * node + 1] = lerp_exact_ends(y0, y1, j, ny);
+        mesh->xy[3 * node + 2] = lerp_exact_ends(z0, z1, k, nz);
+      }
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        int *nodes = mesh->elem + 8 * ((k * ny + j) * nx + i);
+        nodes[0] = k * sz + j * sy + i; /* the bottom face counterclockwise */
+        nodes[1] = nodes[0] + sx;
+        nodes[2] = nodes[1] + sy;
+        nodes[3] = nodes[0] + sy;
+        for (int a = 0; a < 4; ++a) nodes[a + 4] = nodes[a] + sz; /* the top face */
+      }
+  mesh->is_ellipse = 0;
+  const double bounds[6] = {x0, y0, x1, y1, z0, z1};
+  for (int d = 0; d < 6; ++d) mesh->bounds[d] = bounds[d];
   mesh_finish(mesh);
   *out = mesh;
   return SP_OK;
@@ -395,7 +460,7 @@ int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
   int n_elems = n * n + 4 * n * grid.n_rings;
 
   sp_mesh *mesh;
-  SP_CALL(mesh_allocate(n_nodes, n_elems, &mesh));
+  SP_CALL(mesh_allocate(2, n_nodes, n_elems, &mesh));
   disk_fill(&grid, buffer_layers, buffer_width, mesh);
 
   int *new_of_old = malloc((size_t)n_nodes * sizeof *new_of_old);
@@ -432,10 +497,11 @@ double sp_mesh_region_area(const sp_mesh *mesh, int region) {
   double area = 0;
   for (int e = 0; e < mesh->n_elems; ++e) {
     if (mesh->region[e] != region) continue;
-    double xy[4][2], N[4], dNdx[4][2], x[2], w;
-    sp_mesh_elem_xy(mesh, e, xy);
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      sp_q1_point(xy, q, N, dNdx, x, &w);
+    double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], N[SP_Q1_MAX_NODES];
+    double dNdx[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], x[SP_Q1_MAX_DIM], w;
+    sp_mesh_elem_xy(mesh, e, xe);
+    for (int q = 0; q < sp_q1_qpoints(mesh->dim); ++q) {
+      sp_q1_point(mesh->dim, xe, q, N, dNdx, x, &w);
       area += w;
     }
   }
@@ -443,7 +509,7 @@ double sp_mesh_region_area(const sp_mesh *mesh, int region) {
 }
 
 int sp_mesh_contains(const sp_mesh *mesh, double x, double y) {
-  if (!mesh) return 0;
+  if (!mesh) return 0; /* (2D: a box's z is not asked) */
   const double *bd = mesh->bounds;
   if (mesh->is_ellipse) {
     double u = x / bd[2], v = y / bd[3];

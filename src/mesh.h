@@ -1,10 +1,17 @@
 /**
  * @file mesh.h
- * @brief Quadrilateral meshes: rectangles and the paper's five-patch disk
- *        mapped to an ellipse, optionally with a buffer ring outside Omega.
+ * @brief Q1 meshes of either dimension (q1.h): quadrilateral rectangles and
+ *        the paper's five-patch disk mapped to an ellipse, optionally with a
+ *        buffer ring outside Omega (2D), and hexahedral boxes (3D). The
+ *        dimension is the mesh's: code that loops over elements reads
+ *        dim and nodes_per_elem from it.
  */
 #ifndef SP_MESH_H
 #define SP_MESH_H
+
+#include <stddef.h>
+
+#include "q1.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -13,19 +20,25 @@ extern "C" {
 /** Element regions. */
 enum { SP_REGION_OMEGA = 0, SP_REGION_BUFFER = 1 };
 
-/** A replicated Q1 mesh. Elements list their nodes counterclockwise. */
+/** A replicated Q1 mesh. Elements list their nodes in q1.h's order
+ *  (a quadrilateral counterclockwise; a hexahedron's bottom face
+ *  counterclockwise seen from above, then its top face). */
 typedef struct sp_mesh {
   int n_nodes, n_elems;
-  double *xy;       /**< 2 * n_nodes coordinates */
-  int *elem;        /**< 4 * n_elems node indices, counterclockwise */
+  int dim;            /**< 2 (quadrilaterals) or 3 (hexahedra) */
+  int nodes_per_elem; /**< sp_q1_nodes(dim): 4 or 8 */
+  double *xy;       /**< dim * n_nodes coordinates: x, y (and z in 3D) */
+  int *elem;        /**< nodes_per_elem * n_elems node indices */
   int *region;      /**< per element: SP_REGION_OMEGA or SP_REGION_BUFFER */
-  int is_ellipse;   /**< 1 for the ellipse mesh, 0 for a rectangle */
-  double bounds[4]; /**< Omega: rectangle x0, y0, x1, y1; ellipse 0, 0, a, b */
+  int is_ellipse;   /**< 1 for the ellipse mesh, 0 for a rectangle or box */
+  double bounds[6]; /**< Omega: rectangle x0, y0, x1, y1; ellipse 0, 0, a, b;
+                         box x0, y0, x1, y1, z0, z1 */
   double h;         /**< largest element edge length */
   /** The Q1 geometry at element e's Gauss point q (sp_q1_point), made once
    *  with the mesh so that loops over elements (src/cells.c) need not
-   *  recompute it: the weight |det J| at [4 e + q], the point at
-   *  [2 (4 e + q)] and [2 (4 e + q) + 1]. NULL in a mesh not made here. */
+   *  recompute it: with nq = sp_q1_qpoints(dim), the weight |det J| at
+   *  [nq e + q], the point's coordinate d at [dim (nq e + q) + d]. NULL in
+   *  a mesh not made here. */
   double *q1_w, *q1_x;
 } sp_mesh;
 
@@ -48,6 +61,18 @@ int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
 int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
                     double buffer_width, sp_mesh **out);
 
+/**
+ * @brief The box [x0,x1] x [y0,y1] x [z0,z1] with nx x ny x nz hexahedra
+ *        (a 3D mesh). Nodes are numbered x fastest, then y, then z.
+ * @param[out] out the new mesh (destroy with sp_mesh_destroy)
+ * @return SP_OK or an error code with a message
+ */
+int sp_mesh_box(double x0, double y0, double z0, double x1, double y1, double z1, int nx,
+                int ny, int nz, sp_mesh **out);
+
+/** @brief The number of nodes sp_mesh_box makes, (nx+1)(ny+1)(nz+1). */
+long long sp_mesh_box_nodes(int nx, int ny, int nz);
+
 /** @brief The number of nodes sp_mesh_rectangle makes for @p nx x @p ny
  *         elements, (nx+1)(ny+1), computed without building the mesh. */
 long long sp_mesh_rectangle_nodes(int nx, int ny);
@@ -56,7 +81,8 @@ long long sp_mesh_rectangle_nodes(int nx, int ny);
  *         n = 2^refinements and L = buffer_layers, without building the mesh. */
 long long sp_mesh_ellipse_nodes(int refinements, int buffer_layers);
 
-/** @brief Area of the elements of one region (2x2 Gauss quadrature). */
+/** @brief Measure of the elements of one region: area in 2D, volume in 3D
+ *         (the Gauss rule of q1.h). */
 double sp_mesh_region_area(const sp_mesh *mesh, int region);
 
 /** @brief 1 if (x, y) lies in Omega (closed), else 0. */
@@ -65,12 +91,14 @@ int sp_mesh_contains(const sp_mesh *mesh, double x, double y);
 /** @brief Free the mesh and set *mesh to NULL. */
 void sp_mesh_destroy(sp_mesh **mesh);
 
-/** @brief Copy element e's node coordinates into xy[4][2]. */
-static inline void sp_mesh_elem_xy(const sp_mesh *m, int e, double xy[4][2]) {
-  for (int a = 0; a < 4; ++a) {
-    int n = m->elem[4 * e + a];
-    xy[a][0] = m->xy[2 * n];
-    xy[a][1] = m->xy[2 * n + 1];
+/** @brief Copy element e's node coordinates into xe[a][d], a <
+ *         nodes_per_elem, d < dim (the rest of xe is left as it is). */
+static inline void sp_mesh_elem_xy(const sp_mesh *m, int e,
+                                   double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM]) {
+  const int nen = m->nodes_per_elem, dim = m->dim;
+  for (int a = 0; a < nen; ++a) {
+    const int n = m->elem[(size_t)nen * e + a];
+    for (int d = 0; d < dim; ++d) xe[a][d] = m->xy[(size_t)dim * n + d];
   }
 }
 

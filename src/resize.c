@@ -8,7 +8,8 @@
 #include "solver_status.h"
 
 int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *layout) {
-  const long long nonzeros = sp_layout_nonzeros_bound(layout);
+  /* (checked first, before the mesh is read: a NULL mesh counts as 2D) */
+  const long long nonzeros = sp_layout_nonzeros_bound(layout, mesh ? mesh->dim : 2);
   SP_CHECK(nonzeros <= SP_LAYOUT_MAX_NONZEROS, SP_ERR_MEMORY,
            "layout: %d cells on %d (cell, node) pairs: the Jacobian would hold up to %lld "
            "nonzeros, more than the %lld the solvers' 32-bit offsets count (fewer cells per "
@@ -19,7 +20,9 @@ int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *lay
   int *first_node;
   SP_ALLOC(first_node, (size_t)n_ranks + 1);
   sp_partition_ranges(layout, n_ranks, first_node);
-  sp_mesh_view mv = {mesh->n_nodes, mesh->n_elems, mesh->xy, mesh->elem, mesh->region};
+  sp_mesh_view mv = {.n_nodes = mesh->n_nodes, .n_elems = mesh->n_elems, .xy = mesh->xy,
+                     .elem = mesh->elem, .region = mesh->region, .dim = mesh->dim,
+                     .nodes_per_elem = mesh->nodes_per_elem};
   const sp_slots *slots; /* the element-slot table: the glue's too */
   const int rc = sp_layout_slots(layout, mesh, &slots);
   if (rc != SP_OK) {

@@ -1414,7 +1414,7 @@ static int check_sizes(const sp_scene *scene, const char *file) {
   const int full = scene->layout.support == SP_SUPPORT_FULL ||
                    (scene->layout.support == SP_SUPPORT_AUTO && scene->n_cells <= 4 &&
                     scene->division.criterion == SP_DIVIDE_NONE);
-  const long long nonzeros = sp_nonzeros_bound(nodes, scene->n_cells);
+  const long long nonzeros = sp_nonzeros_bound(2, nodes, scene->n_cells);
   SP_CHECK(!full || nonzeros <= SP_LAYOUT_MAX_NONZEROS, SP_ERR_INPUT,
            "%s: %s, cells (%d cells) and layout.support (every cell on every node): too "
            "large: the Jacobian would hold up to %lld nonzeros (%lld nodes x 9 x %d x %d), "

@@ -96,11 +96,11 @@ static void test_axis_of_ellipses(void) {
 static double *nodal_weights(const sp_mesh *mesh) {
   double *w = calloc((size_t)mesh->n_nodes, sizeof(double));
   for (int e = 0; e < mesh->n_elems; ++e) {
-    double xy[4][2];
+    double xy[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
     sp_mesh_elem_xy(mesh, e, xy);
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      double N[4], dNdx[4][2], x[2], weight;
-      sp_q1_point(xy, q, N, dNdx, x, &weight);
+    for (int q = 0; q < sp_q1_qpoints(2); ++q) {
+      double N[SP_Q1_MAX_NODES], dNdx[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], x[SP_Q1_MAX_DIM], weight;
+      sp_q1_point(2, xy, q, N, dNdx, x, &weight);
       for (int a = 0; a < 4; ++a) w[mesh->elem[4 * e + a]] += weight * N[a];
     }
   }

@@ -85,8 +85,8 @@ int main(int argc, char **argv) {
    * before the glue sees it, as too large (memory), not as bad input */
   sp_layout *huge = NULL;
   CHECK_OK(sp_layout_create_full(2938 * 2901, 4, &huge));
-  CHECK(sp_layout_nonzeros_bound(huge) == 2147830776LL, "bound %lld",
-        sp_layout_nonzeros_bound(huge));
+  CHECK(sp_layout_nonzeros_bound(huge, 2) == 2147830776LL, "bound %lld",
+        sp_layout_nonzeros_bound(huge, 2));
   rc = sp_solver_attach(NULL, NULL, huge);
   CHECK(rc == SP_ERR_MEMORY && strstr(sp_error_message(), "nonzeros"),
         "a layout with too many nonzeros: rc %d: %s", rc, sp_error_message());

@@ -22,10 +22,11 @@ typedef struct {
 static jacobian_stats mesh_jacobians(const sp_mesh *m) {
   jacobian_stats s = {INFINITY, -INFINITY, 1.0};
   for (int e = 0; e < m->n_elems; ++e) {
-    double xy[4][2], N[4], dNdx[4][2], x[2], w, lo = INFINITY, hi = -INFINITY;
+    double xy[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], N[SP_Q1_MAX_NODES];
+    double dNdx[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], x[SP_Q1_MAX_DIM], w, lo = INFINITY, hi = -INFINITY;
     sp_mesh_elem_xy(m, e, xy);
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      double det = sp_q1_point(xy, q, N, dNdx, x, &w);
+    for (int q = 0; q < sp_q1_qpoints(m->dim); ++q) {
+      double det = sp_q1_point(m->dim, xy, q, N, dNdx, x, &w);
       if (det < lo) lo = det;
       if (det > hi) hi = det;
     }

@@ -69,12 +69,12 @@ static double mms_error(int n, int n_steps, double T, time_fn g) {
   static const double gw[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
   double err2 = 0;
   for (int e = 0; e < mesh->n_elems; ++e) {
-    double xy[4][2];
+    double xy[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
     sp_mesh_elem_xy(mesh, e, xy);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
-        double N[4], dN[4][2];
-        sp_q1_shape(gp[i], gp[j], N, dN);
+        double N[SP_Q1_MAX_NODES], dN[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+        sp_q1_shape(2, (double[SP_Q1_MAX_DIM]){gp[i], gp[j], 0}, N, dN);
         double x = 0, y = 0, ch = 0;
         for (int a = 0; a < 4; ++a) {
           x += N[a] * xy[a][0];

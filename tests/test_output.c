@@ -131,7 +131,8 @@ int main(void) {
       elem[4 * e + 3] = node(ix, iy + 1);
       region[e] = ix == NX - 1 ? SP_REGION_BUFFER : SP_REGION_OMEGA;
     }
-  sp_mesh mesh = {.n_nodes = NN, .n_elems = NE, .xy = xy, .elem = elem,
+  sp_mesh mesh = {.n_nodes = NN, .n_elems = NE, .dim = 2, .nodes_per_elem = 4, .xy = xy,
+                  .elem = elem,
                   .region = region, .is_ellipse = 0,
                   .bounds = {0, 0, 0.5 * NX, 0.5 * NY}, .h = 0.5};
 

@@ -103,11 +103,11 @@ static double node_integral_ihat(const sp_mesh *mesh, int node, double xc, doubl
     for (int l = 0; l < 4; ++l)
       if (mesh->elem[4 * e + l] == node) a = l;
     if (a < 0) continue;
-    double xy[4][2];
+    double xy[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
     sp_mesh_elem_xy(mesh, e, xy);
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      double N[4], dNdx[4][2], x[2], w;
-      sp_q1_point(xy, q, N, dNdx, x, &w);
+    for (int q = 0; q < sp_q1_qpoints(2); ++q) {
+      double N[SP_Q1_MAX_NODES], dNdx[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], x[SP_Q1_MAX_DIM], w;
+      sp_q1_point(2, xy, q, N, dNdx, x, &w);
       const double xb = x[0] - xc, yb = x[1] - yc;
       const double ihat = v[0] * v[0] * yb * yb - 2 * v[0] * v[1] * xb * yb + v[1] * v[1] * xb * xb;
       sum += w * N[a] * ihat;

@@ -153,13 +153,15 @@ static void check_supports(const sp_mesh *m, const sp_layout *l) {
 static void check_geometry(const sp_mesh *m) {
   int64_t differ = 0;
   for (int e = 0; e < m->n_elems; ++e) {
-    double xy[4][2];
+    double xy[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
     sp_mesh_elem_xy(m, e, xy);
-    for (int q = 0; q < SP_Q1_QPOINTS; ++q) {
-      double N[4], dNdx[4][2], x[2], w;
-      sp_q1_point(xy, q, N, dNdx, x, &w);
-      const size_t eq = (size_t)SP_Q1_QPOINTS * e + q;
-      differ += memcmp(&w, m->q1_w + eq, sizeof w) || memcmp(x, m->q1_x + 2 * eq, sizeof x);
+    const int nq = sp_q1_qpoints(m->dim);
+    for (int q = 0; q < nq; ++q) {
+      double N[SP_Q1_MAX_NODES], dNdx[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], x[SP_Q1_MAX_DIM], w;
+      sp_q1_point(m->dim, xy, q, N, dNdx, x, &w);
+      const size_t eq = (size_t)nq * e + q;
+      differ += memcmp(&w, m->q1_w + eq, sizeof w) ||
+                memcmp(x, m->q1_x + (size_t)m->dim * eq, sizeof(double) * m->dim);
     }
   }
   CHECK(differ == 0, "%lld cached Gauss points differ from sp_q1_point's", (long long)differ);
