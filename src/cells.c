@@ -194,13 +194,15 @@ int sp_cells_fill(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *l
   return SP_OK;
 }
 
-/** The scene's cell k: a disk (2D) or a sphere (3D: its z given) with the
+/** The scene's cell k: a disk (2D) or a sphere (3D) with the
  *  tanh profile of width d, or sharp. */
 static double disk_profile(int k, const double *x, int dim, void *ctx) {
   const sp_scene *scene = ctx;
   const sp_scene_cell *cell = &scene->cells[k];
-  (void)dim; /* the scene's disks (2D) */
-  const double r = hypot(x[0] - cell->x, x[1] - cell->y);
+  const double r = dim == 2 ? hypot(x[0] - cell->x, x[1] - cell->y)
+                            : sqrt((x[0] - cell->x) * (x[0] - cell->x) +
+                                   (x[1] - cell->y) * (x[1] - cell->y) +
+                                   (x[2] - cell->z) * (x[2] - cell->z));
   if (cell->profile == SP_PROFILE_SHARP) return r <= cell->radius ? 1.0 : 0.0;
   return sp_cells_profile(r - cell->radius, sp_scene_interface_width(scene));
 }

@@ -359,6 +359,7 @@ static void sync_path(const char *path) {
 }
 
 int sp_checkpoint_write(const sp_run *run, const char *dir, char *path_out, size_t size) {
+  SP_CHECK(run->mesh->dim == 2, SP_ERR_INPUT, "checkpoints are not yet on a 3D mesh (issue 29)");
   char path[4096], tmp[4200];
   checkpoint_path(dir, run->step, path, sizeof path);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);

@@ -106,6 +106,8 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
                       const sp_cell_obs *parent_obs, int smooth, double width,
                       double offset, const sp_layout *new_layout, double *new_state,
                       int child) {
+  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
+           "division: divisions are not yet on a 3D mesh (issue 29)");
   SP_CHECK(layout->n_nodes == mesh->n_nodes && new_layout->n_nodes == mesh->n_nodes,
            SP_ERR_INTERNAL, "division split: layouts have %d and %d nodes, the mesh %d",
            layout->n_nodes, new_layout->n_nodes, mesh->n_nodes);
@@ -181,6 +183,9 @@ int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
                                const sp_cell_obs *parent_obs, int smooth, double width,
                                double *offset) {
   *offset = 0.0;
+  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
+           "division: divisions are not yet on a 3D mesh (issue 29)");
+
   /* w_i = int phi_i over the parent's whole elements (sp_cells_observe's rule) */
   const size_t nn = (size_t)mesh->n_nodes;
   double *buffer; /* one block: nothing leaks on the error return */

@@ -314,6 +314,8 @@ int sp_initial_cell_count(const sp_scene *scene, int *n_cells) {
 
 int sp_initial_state(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *layout,
                      double *state) {
+  SP_CHECK(mesh->dim == 2 || !(scene->initial.label_image[0] || scene->initial.from[0]),
+           SP_ERR_INPUT, "initial: fields from files are not yet on a 3D mesh (issue 29)");
   if (scene->initial.label_image[0]) return label_image_state(scene, mesh, layout, state);
   if (scene->initial.from[0]) return vtu_state(scene, mesh, layout, state);
   return sp_cells_initial_state(scene, mesh, layout, state);

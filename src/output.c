@@ -33,6 +33,7 @@ struct sp_output_s {
   char *dir;
   char *energy_path, *cells_path, *divisions_path;
   FILE *energy, *cells, *divisions;
+  int dim; /**< the mesh's: cells.csv has z on a 3D one */
   int n_fields, cap_fields;
   sp_output_field *fields; /**< each fields file written, in write order */
 };
@@ -267,14 +268,20 @@ static const struct {
     {"divisions.csv",
      "t,step,parent,child,axis_angle,parent_mass_before,parent_mass_after,child_mass_after", 1}};
 
-/** Open @p dir's logs: new ones (@p resume_step < 0), or the existing ones
- *  cut back to the rows of steps <= @p resume_step and appended to. */
-static int output_open(const char *dir, int resume_step, sp_output *out) {
+/** cells.csv's header on a 3D mesh: the centre with z, the volume inside
+ *  the membrane; no moments yet (issue 29). */
+static const char sp_cells_header_3d[] = "step,t,cell,mass,xc,yc,zc,core_mass,volume";
+
+/** Open @p dir's logs for a mesh of dimension @p dim: new ones
+ *  (@p resume_step < 0), or the existing ones cut back to the rows of steps
+ *  <= @p resume_step and appended to. */
+static int output_open(const char *dir, int dim, int resume_step, sp_output *out) {
   *out = NULL;
   SP_CALL(sp_mkdir_p(dir));
   struct sp_output_s *o;
   SP_ALLOC(o, 1);
   o->dir = sp_strfmt("%s", dir);
+  o->dim = dim;
   o->energy_path = sp_strfmt("%s/%s", dir, sp_logs[0].name);
   o->cells_path = sp_strfmt("%s/%s", dir, sp_logs[1].name);
   o->divisions_path = sp_strfmt("%s/%s", dir, sp_logs[2].name);
@@ -287,7 +294,8 @@ static int output_open(const char *dir, int resume_step, sp_output *out) {
   for (int i = 0; i < 3 && rc == SP_OK; ++i) {
     int exists = 0;
     if (resume_step >= 0) rc = sp_log_cut(paths[i], sp_logs[i].step_column, resume_step, &exists);
-    if (rc == SP_OK) rc = sp_log_open(paths[i], exists ? NULL : sp_logs[i].header, files[i]);
+    const char *header = i == 1 && dim == 3 ? sp_cells_header_3d : sp_logs[i].header;
+    if (rc == SP_OK) rc = sp_log_open(paths[i], exists ? NULL : header, files[i]);
   }
   if (rc != SP_OK) {
     sp_output_close(&o); /* keeps the first error's message */
@@ -297,7 +305,12 @@ static int output_open(const char *dir, int resume_step, sp_output *out) {
   return SP_OK;
 }
 
-int sp_output_open(const char *dir, sp_output *out) { return output_open(dir, -1, out); }
+int sp_output_open(const char *dir, sp_output *out) { return output_open(dir, 2, -1, out); }
+
+int sp_output_open_dim(const char *dir, int dim, sp_output *out) {
+  SP_CHECK(dim == 2 || dim == 3, SP_ERR_INTERNAL, "output: dimension %d", dim);
+  return output_open(dir, dim, -1, out);
+}
 
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,
@@ -322,6 +335,13 @@ int sp_output_energy(sp_output out, int step, double t, double dt,
 int sp_output_cells(sp_output out, int step, double t, int n_cells,
                     const sp_cell_obs *obs) {
   int n = 0;
+  if (out->dim == 3) {
+    for (int k = 0; k < n_cells && n >= 0; ++k)
+      n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", step, t,
+                  k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].zc, obs[k].mass_core,
+                  obs[k].area);
+    return sp_log_done(out->cells, out->cells_path, n);
+  }
   for (int k = 0; k < n_cells && n >= 0; ++k)
     n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
                 step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].I1,
@@ -634,6 +654,8 @@ static int sp_fields_record(struct sp_output_s *o, int step, double t, int pvtu)
 int sp_output_fields(sp_output out, const sp_mesh *mesh,
                      const sp_layout *layout, const double *state, int step,
                      double t) {
+  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
+           "output: the VTU fields are not yet on a 3D mesh (issue 29)");
   SP_CHECK(mesh->n_nodes == layout->n_nodes, SP_ERR_INTERNAL,
            "output: mesh has %d nodes but layout has %d", mesh->n_nodes,
            layout->n_nodes);
@@ -658,6 +680,8 @@ int sp_output_fields(sp_output out, const sp_mesh *mesh,
 int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout *layout,
                            const double *state, int step, double t, int rank,
                            int first_node, int end_node) {
+  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
+           "output: the VTU fields are not yet on a 3D mesh (issue 29)");
   SP_CHECK(mesh->n_nodes == layout->n_nodes && first_node >= 0 && first_node <= end_node &&
            end_node <= mesh->n_nodes && step >= 0 && rank >= 0, SP_ERR_INTERNAL,
            "output piece: nodes %d..%d of %d (layout %d), step %d, rank %d", first_node,
@@ -732,7 +756,7 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
 
 int sp_output_resume(const char *dir, int step, int n_fields, const sp_output_field *fields,
                      sp_output *out) {
-  SP_CALL(output_open(dir, step, out));
+  SP_CALL(output_open(dir, 2, step, out)); /* (checkpoints are 2D) */
   for (int i = 0; i < n_fields; ++i)
     if (fields[i].step <= step) {
       int rc = sp_fields_record(*out, fields[i].step, fields[i].t, fields[i].pvtu);

@@ -18,8 +18,13 @@ extern "C" {
 
 typedef struct sp_output_s *sp_output;
 
-/** @brief Create @p dir (and parents) and start the CSV logs with headers. */
+/** @brief Create @p dir (and parents) and start the CSV logs with headers
+ *         (a 2D mesh's). */
 int sp_output_open(const char *dir, sp_output *out);
+
+/** @brief sp_output_open for a mesh of dimension @p dim (2 or 3): on a 3D
+ *         mesh cells.csv is step,t,cell,mass,xc,yc,zc,core_mass,volume. */
+int sp_output_open_dim(const char *dir, int dim, sp_output *out);
 
 /** One fields file of fields.pvd: fields_<step>.vtu, or .pvtu of pieces. */
 typedef struct {

@@ -378,6 +378,8 @@ static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
 int sp_render_cells(const sp_mesh *mesh, const sp_layout *layout,
                     const double *state, double t, int width_px,
                     const char *path) {
+  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
+           "render: pictures are not yet on a 3D mesh (issue 29)");
   SP_CHECK(layout && layout->n_nodes == mesh->n_nodes, SP_ERR_INTERNAL,
            "render: mesh has %d nodes but layout has %d", mesh->n_nodes,
            layout ? layout->n_nodes : -1);

@@ -5,6 +5,8 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
   const sp_scene_mesh *m = &scene->mesh;
   if (m->type == SP_MESH_RECTANGLE)
     return sp_mesh_rectangle(m->x0, m->y0, m->x1, m->y1, m->nx, m->ny, out);
+  if (m->type == SP_MESH_BOX)
+    return sp_mesh_box(m->x0, m->y0, m->z0, m->x1, m->y1, m->z1, m->nx, m->ny, m->nz, out);
   return sp_mesh_ellipse(m->refinements, m->semi_x, m->semi_y, m->buffer_layers,
                          m->buffer_width, out);
 }

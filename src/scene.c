@@ -123,7 +123,7 @@ typedef struct {
 } sp_key;
 
 static const cyaml_strval_t sp_mesh_words[] = {
-    {"rectangle", SP_MESH_RECTANGLE}, {"ellipse", SP_MESH_ELLIPSE}};
+    {"rectangle", SP_MESH_RECTANGLE}, {"ellipse", SP_MESH_ELLIPSE}, {"box", SP_MESH_BOX}};
 static const cyaml_strval_t sp_profile_words[] = {
     {"tanh", SP_PROFILE_TANH}, {"sharp", SP_PROFILE_SHARP}};
 static const cyaml_strval_t sp_jacobian_words[] = {
@@ -202,6 +202,10 @@ _Static_assert(sizeof(sp_linear_kind) == sizeof(int), "enum size");
   {SP_SEC_CELLS, name, SP_KEY_FLOAT,                                           \
    MEMBER_OFFSET(sp_scene_cell, member, double), 0.0, 1, lo, hi, NULL, 0,      \
    unit, meaning}
+#define CELL_FLOAT(name, member, def, lo, hi, unit, meaning)                   \
+  {SP_SEC_CELLS, name, SP_KEY_FLOAT,                                           \
+   MEMBER_OFFSET(sp_scene_cell, member, double), def, 0, lo, hi, NULL, 0,      \
+   unit, meaning}
 #define CELL_ENUM(name, member, def, words, unit, meaning)                     \
   {SP_SEC_CELLS, name, SP_KEY_ENUM, ENUM_MEMBER_OFFSET(sp_scene_cell, member), \
    def, 0, UNBOUNDED, UNBOUNDED, words, CYAML_ARRAY_LEN(words), unit, meaning}
@@ -212,19 +216,27 @@ _Static_assert(sizeof(sp_linear_kind) == sizeof(int), "enum size");
 static const sp_key sp_keys[] = {
     /* mesh */
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
-             "-", "domain Omega: a rectangle or the paper's ellipse"),
+             "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
+             "of hexahedra (3D; not yet with divisions, the shape term, local "
+             "supports, checkpoints, initial files, fields or pictures: issue 29)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
-              "rectangle: left edge"),
+              "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
-              "rectangle: bottom edge"),
+              "rectangle, box: bottom edge (front in a box)"),
     KEY_FLOAT(SP_SEC_MESH, "x1", mesh.x1, 1.0, UNBOUNDED, UNBOUNDED, "L",
-              "rectangle: right edge (> x0)"),
+              "rectangle, box: right edge (> x0)"),
     KEY_FLOAT(SP_SEC_MESH, "y1", mesh.y1, 1.0, UNBOUNDED, UNBOUNDED, "L",
-              "rectangle: top edge (> y0)"),
+              "rectangle, box: top edge (back in a box; > y0)"),
     KEY_INT(SP_SEC_MESH, "nx", mesh.nx, 64, AT_LEAST(1), AT_MOST(4096),
-            "elements", "rectangle: elements along x"),
+            "elements", "rectangle, box: elements along x"),
     KEY_INT(SP_SEC_MESH, "ny", mesh.ny, 64, AT_LEAST(1), AT_MOST(4096),
-            "elements", "rectangle: elements along y"),
+            "elements", "rectangle, box: elements along y"),
+    KEY_FLOAT(SP_SEC_MESH, "z0", mesh.z0, 0.0, UNBOUNDED, UNBOUNDED, "L",
+              "box: bottom face"),
+    KEY_FLOAT(SP_SEC_MESH, "z1", mesh.z1, 1.0, UNBOUNDED, UNBOUNDED, "L",
+              "box: top face (> z0)"),
+    KEY_INT(SP_SEC_MESH, "nz", mesh.nz, 16, AT_LEAST(1), AT_MOST(1024),
+            "elements", "box: elements along z"),
     KEY_INT(SP_SEC_MESH, "refinements", mesh.refinements, 5, AT_LEAST(0),
             AT_MOST(9), "-",
             "ellipse: uniform refinements of the five-patch disk "
@@ -508,6 +520,9 @@ static const sp_key sp_keys[] = {
                         "centre x; the cell's disk must lie inside Omega"),
     CELL_FLOAT_REQUIRED("y", y, UNBOUNDED, UNBOUNDED, "L",
                         "centre y; the cell's disk must lie inside Omega"),
+    CELL_FLOAT("z", z, NAN, UNBOUNDED, UNBOUNDED, "L",
+               "centre z: required on a 3D mesh (mesh.type box), where the cell is "
+               "a sphere inside the box; not allowed on a 2D one"),
     CELL_FLOAT_REQUIRED("radius", radius, ABOVE(0.0), UNBOUNDED, "L",
                         "radius of the c = 1/2 level set"),
     CELL_ENUM("profile", profile, SP_PROFILE_TANH, sp_profile_words, "-",
@@ -1325,7 +1340,7 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
            "%s: layout.band: expected a number < layout.margin = %.15g, got "
            "%.15g",
            file, scene->layout.margin, scene->layout.band);
-  if (scene->mesh.type == SP_MESH_RECTANGLE) {
+  if (scene->mesh.type == SP_MESH_RECTANGLE || scene->mesh.type == SP_MESH_BOX) {
     const sp_scene_mesh *m = &scene->mesh;
     SP_CHECK(m->x1 > m->x0, SP_ERR_INPUT,
              "%s: mesh.x1: expected a number > mesh.x0 = %.15g, got %.15g",
@@ -1334,6 +1349,75 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
              "%s: mesh.y1: expected a number > mesh.y0 = %.15g, got %.15g",
              file, m->y0, m->y1);
   }
+  if (scene->mesh.type == SP_MESH_BOX) {
+    const sp_scene_mesh *m = &scene->mesh;
+    SP_CHECK(m->z1 > m->z0, SP_ERR_INPUT,
+             "%s: mesh.z1: expected a number > mesh.z0 = %.15g, got %.15g",
+             file, m->z0, m->z1);
+  }
+  return SP_OK;
+}
+
+/** Why a 3D scene cannot have a feature yet (issue 29's later phases). */
+#define SP_NOT_YET_3D "not yet in 3D (mesh.type box; issue 29)"
+
+/** What a scene on a 3D mesh cannot ask for yet, each refused naming its
+ *  key, rather than run wrong: divisions, the shape term, local supports,
+ *  pictures, checkpoints and initial fields from files (the VTU fields are
+ *  not written in 3D: no key asks for them). */
+static int check_3d(const sp_scene *scene, const char *file) {
+  if (sp_scene_dim(scene) != 3) return SP_OK;
+  SP_CHECK(scene->division.criterion == SP_DIVIDE_NONE, SP_ERR_INPUT,
+           "%s: division.criterion: divisions are " SP_NOT_YET_3D ": expected none", file);
+  SP_CHECK(scene->shape.delta1 == 0, SP_ERR_INPUT,
+           "%s: shape.delta1: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
+           scene->shape.delta1);
+  SP_CHECK(scene->shape.delta2 == 0, SP_ERR_INPUT,
+           "%s: shape.delta2: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
+           scene->shape.delta2);
+  /* layout.support auto is local beyond 4 cells (run_setup.c) */
+  SP_CHECK(scene->layout.support == SP_SUPPORT_FULL ||
+               (scene->layout.support == SP_SUPPORT_AUTO && scene->n_cells <= 4),
+           SP_ERR_INPUT,
+           "%s: layout.support: local supports are " SP_NOT_YET_3D
+           ": expected full (auto is local beyond 4 cells; the scene has %d)",
+           file, scene->n_cells);
+  SP_CHECK(!scene->output.pictures, SP_ERR_INPUT,
+           "%s: output.pictures: pictures are " SP_NOT_YET_3D ": expected false", file);
+  SP_CHECK(scene->output.checkpoint_every == 0, SP_ERR_INPUT,
+           "%s: output.checkpoint_every: checkpoints are " SP_NOT_YET_3D ": expected 0, got %d",
+           file, scene->output.checkpoint_every);
+  SP_CHECK(scene->output.checkpoint_seconds == 0, SP_ERR_INPUT,
+           "%s: output.checkpoint_seconds: checkpoints are " SP_NOT_YET_3D
+           ": expected 0, got %.15g", file, scene->output.checkpoint_seconds);
+  SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
+           "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
+           ": expected none, got '%s'", file, scene->initial.from);
+  SP_CHECK(scene->initial.label_image[0] == '\0', SP_ERR_INPUT,
+           "%s: initial.label_image: label images (and 3D label volumes) are " SP_NOT_YET_3D
+           ": expected none, got '%s'", file, scene->initial.label_image);
+  return SP_OK;
+}
+
+/** Every cell's centre, and its whole sphere, inside the box; its z given. */
+static int check_sphere(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
+                        const char *file) {
+  SP_CHECK(!isnan(c->z), SP_ERR_INPUT,
+           "%s: cells[%d].z: required on a 3D mesh (mesh.type box): the cell is a sphere", file,
+           i);
+  const double lo[3] = {m->x0, m->y0, m->z0}, hi[3] = {m->x1, m->y1, m->z1};
+  const double x[3] = {c->x, c->y, c->z}, r = c->radius;
+  static const char *const name[3] = {"x", "y", "z"};
+  for (int d = 0; d < 3; ++d)
+    SP_CHECK(x[d] >= lo[d] && x[d] <= hi[d], SP_ERR_INPUT,
+             "%s: cells[%d].%s: the centre %s = %.15g is outside the box's [mesh.%s0, "
+             "mesh.%s1] = [%.15g, %.15g]",
+             file, i, name[d], name[d], x[d], name[d], name[d], lo[d], hi[d]);
+  for (int d = 0; d < 3; ++d)
+    SP_CHECK(x[d] - r >= lo[d] && x[d] + r <= hi[d], SP_ERR_INPUT,
+             "%s: cells[%d].radius: the sphere of radius %.15g around (%.15g, %.15g, %.15g) "
+             "is not inside the box [%.15g, %.15g] x [%.15g, %.15g] x [%.15g, %.15g]",
+             file, i, r, x[0], x[1], x[2], lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
   return SP_OK;
 }
 
@@ -1342,46 +1426,66 @@ static double ellipse_level(const sp_scene_mesh *m, double x, double y) {
   return (x / m->semi_x) * (x / m->semi_x) + (y / m->semi_y) * (y / m->semi_y);
 }
 
-/** Every cell's centre, and its whole disk, inside Omega. */
+/** Cell @p i's centre, and its whole disk, inside the rectangle. */
+static int check_disk_in_rectangle(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
+                                   const char *file) {
+  const double r = c->radius;
+  SP_CHECK(c->x >= m->x0 && c->x <= m->x1, SP_ERR_INPUT,
+           "%s: cells[%d].x: the centre x = %.15g is outside the "
+           "rectangle's [mesh.x0, mesh.x1] = [%.15g, %.15g]",
+           file, i, c->x, m->x0, m->x1);
+  SP_CHECK(c->y >= m->y0 && c->y <= m->y1, SP_ERR_INPUT,
+           "%s: cells[%d].y: the centre y = %.15g is outside the "
+           "rectangle's [mesh.y0, mesh.y1] = [%.15g, %.15g]",
+           file, i, c->y, m->y0, m->y1);
+  SP_CHECK(c->x - r >= m->x0 && c->x + r <= m->x1 && c->y - r >= m->y0 &&
+               c->y + r <= m->y1,
+           SP_ERR_INPUT,
+           "%s: cells[%d].radius: the disk of radius %.15g around "
+           "(%.15g, %.15g) is not inside the rectangle [%.15g, %.15g] x "
+           "[%.15g, %.15g]",
+           file, i, r, c->x, c->y, m->x0, m->x1, m->y0, m->y1);
+  return SP_OK;
+}
+
+/** Cell @p i's centre, and its whole disk, inside the ellipse. */
+static int check_disk_in_ellipse(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
+                                 const char *file) {
+  const double r = c->radius;
+  double level = ellipse_level(m, c->x, c->y);
+  SP_CHECK(level <= 1.0, SP_ERR_INPUT,
+           "%s: cells[%d].x, cells[%d].y: the centre (%.15g, %.15g) is "
+           "outside the ellipse (x/%.15g)^2 + (y/%.15g)^2 <= 1 (it gives "
+           "%.6g)",
+           file, i, i, c->x, c->y, m->semi_x, m->semi_y, level);
+  const double full_turn = 2.0 * acos(-1.0);
+  for (int j = 0; j < SP_DISK_CHECK_ANGLES; ++j) {
+    double angle = full_turn * j / SP_DISK_CHECK_ANGLES;
+    double px = c->x + r * cos(angle), py = c->y + r * sin(angle);
+    SP_CHECK(ellipse_level(m, px, py) <= 1.0, SP_ERR_INPUT,
+             "%s: cells[%d].radius: the disk of radius %.15g around "
+             "(%.15g, %.15g) is not inside the ellipse with semi-axes "
+             "(%.15g, %.15g): its point (%.6g, %.6g) is outside",
+             file, i, r, c->x, c->y, m->semi_x, m->semi_y, px, py);
+  }
+  return SP_OK;
+}
+
+/** Every cell's centre, and its whole disk (sphere), inside Omega; z
+ *  given exactly on a 3D mesh. */
 static int check_cells(const sp_scene *scene, const char *file) {
   const sp_scene_mesh *m = &scene->mesh;
   for (int i = 0; i < scene->n_cells; ++i) {
     const sp_scene_cell *c = &scene->cells[i];
-    double r = c->radius;
-    if (m->type == SP_MESH_RECTANGLE) {
-      SP_CHECK(c->x >= m->x0 && c->x <= m->x1, SP_ERR_INPUT,
-               "%s: cells[%d].x: the centre x = %.15g is outside the "
-               "rectangle's [mesh.x0, mesh.x1] = [%.15g, %.15g]",
-               file, i, c->x, m->x0, m->x1);
-      SP_CHECK(c->y >= m->y0 && c->y <= m->y1, SP_ERR_INPUT,
-               "%s: cells[%d].y: the centre y = %.15g is outside the "
-               "rectangle's [mesh.y0, mesh.y1] = [%.15g, %.15g]",
-               file, i, c->y, m->y0, m->y1);
-      SP_CHECK(c->x - r >= m->x0 && c->x + r <= m->x1 && c->y - r >= m->y0 &&
-                   c->y + r <= m->y1,
-               SP_ERR_INPUT,
-               "%s: cells[%d].radius: the disk of radius %.15g around "
-               "(%.15g, %.15g) is not inside the rectangle [%.15g, %.15g] x "
-               "[%.15g, %.15g]",
-               file, i, r, c->x, c->y, m->x0, m->x1, m->y0, m->y1);
-    } else {
-      double level = ellipse_level(m, c->x, c->y);
-      SP_CHECK(level <= 1.0, SP_ERR_INPUT,
-               "%s: cells[%d].x, cells[%d].y: the centre (%.15g, %.15g) is "
-               "outside the ellipse (x/%.15g)^2 + (y/%.15g)^2 <= 1 (it gives "
-               "%.6g)",
-               file, i, i, c->x, c->y, m->semi_x, m->semi_y, level);
-      const double full_turn = 2.0 * acos(-1.0);
-      for (int j = 0; j < SP_DISK_CHECK_ANGLES; ++j) {
-        double angle = full_turn * j / SP_DISK_CHECK_ANGLES;
-        double px = c->x + r * cos(angle), py = c->y + r * sin(angle);
-        SP_CHECK(ellipse_level(m, px, py) <= 1.0, SP_ERR_INPUT,
-                 "%s: cells[%d].radius: the disk of radius %.15g around "
-                 "(%.15g, %.15g) is not inside the ellipse with semi-axes "
-                 "(%.15g, %.15g): its point (%.6g, %.6g) is outside",
-                 file, i, r, c->x, c->y, m->semi_x, m->semi_y, px, py);
-      }
+    if (m->type == SP_MESH_BOX) {
+      SP_CALL(check_sphere(m, c, i, file));
+      continue;
     }
+    SP_CHECK(isnan(c->z), SP_ERR_INPUT,
+             "%s: cells[%d].z: only on a 3D mesh (mesh.type box), got %.15g with mesh.type %s",
+             file, i, c->z, m->type == SP_MESH_RECTANGLE ? "rectangle" : "ellipse");
+    if (m->type == SP_MESH_RECTANGLE) SP_CALL(check_disk_in_rectangle(m, c, i, file));
+    else SP_CALL(check_disk_in_ellipse(m, c, i, file));
   }
   return SP_OK;
 }
@@ -1391,13 +1495,17 @@ static int check_cells(const sp_scene *scene, const char *file) {
  *  32-bit global ids; checked here, before anything that large is allocated. */
 static int check_sizes(const sp_scene *scene, const char *file) {
   const sp_scene_mesh *m = &scene->mesh;
-  const int rectangle = m->type == SP_MESH_RECTANGLE;
+  const int rectangle = m->type == SP_MESH_RECTANGLE, box = m->type == SP_MESH_BOX;
   const long long nodes = rectangle ? sp_mesh_rectangle_nodes(m->nx, m->ny)
+                          : box     ? sp_mesh_box_nodes(m->nx, m->ny, m->nz)
                                     : sp_mesh_ellipse_nodes(m->refinements, m->buffer_layers);
   const long long pairs = nodes * scene->n_cells;
   char mesh_keys[SP_TEXT];
   if (rectangle)
     snprintf(mesh_keys, sizeof mesh_keys, "mesh.nx, mesh.ny (%d x %d elements)", m->nx, m->ny);
+  else if (box)
+    snprintf(mesh_keys, sizeof mesh_keys, "mesh.nx, mesh.ny, mesh.nz (%d x %d x %d elements)",
+             m->nx, m->ny, m->nz);
   else
     snprintf(mesh_keys, sizeof mesh_keys,
              "mesh.refinements, mesh.buffer_layers (%d refinements, %d buffer layers)",
@@ -1414,13 +1522,14 @@ static int check_sizes(const sp_scene *scene, const char *file) {
   const int full = scene->layout.support == SP_SUPPORT_FULL ||
                    (scene->layout.support == SP_SUPPORT_AUTO && scene->n_cells <= 4 &&
                     scene->division.criterion == SP_DIVIDE_NONE);
-  const long long nonzeros = sp_nonzeros_bound(2, nodes, scene->n_cells);
+  const int dim = sp_scene_dim(scene);
+  const long long nonzeros = sp_nonzeros_bound(dim, nodes, scene->n_cells);
   SP_CHECK(!full || nonzeros <= SP_LAYOUT_MAX_NONZEROS, SP_ERR_INPUT,
            "%s: %s, cells (%d cells) and layout.support (every cell on every node): too "
-           "large: the Jacobian would hold up to %lld nonzeros (%lld nodes x 9 x %d x %d), "
+           "large: the Jacobian would hold up to %lld nonzeros (%lld nodes x %d x %d x %d), "
            "more than the %lld the solvers' 32-bit offsets count: use fewer elements or "
            "cells, or layout.support: local",
-           file, mesh_keys, scene->n_cells, nonzeros, nodes, scene->n_cells,
+           file, mesh_keys, scene->n_cells, nonzeros, nodes, dim == 3 ? 27 : 9, scene->n_cells,
            scene->n_cells + 3, SP_LAYOUT_MAX_NONZEROS);
   return SP_OK;
 }
@@ -1442,11 +1551,14 @@ static int fill_scene(sp_scene *scene, const char *path, const char *text,
   snprintf(where, sizeof where, "%s%s", path,
            n_set ? " (with its --set overrides)" : "");
   SP_CALL(check_time_and_mesh(scene, where));
+  SP_CALL(check_3d(scene, where));
   SP_CALL(check_initial(scene, where));
   SP_CALL(check_cells(scene, where));
   SP_CALL(check_sizes(scene, where));
   return SP_OK;
 }
+
+int sp_scene_dim(const sp_scene *scene) { return scene->mesh.type == SP_MESH_BOX ? 3 : 2; }
 
 int sp_scene_read_file(const char *path, char **text, size_t *len) {
   return read_file(path, text, len);
@@ -1501,6 +1613,8 @@ void sp_scene_print_keys(FILE *out) {
       snprintf(fallback, sizeof fallback, "required");
     else if (key->type == SP_KEY_BOOL || key->type == SP_KEY_ENUM)
       snprintf(fallback, sizeof fallback, "%s", word_of(key, key->fallback));
+    else if (isnan(key->fallback))
+      snprintf(fallback, sizeof fallback, "none");
     else
       snprintf(fallback, sizeof fallback, "%.15g", key->fallback);
     fprintf(out, "| `%s` | %s | %s | %s | %s | %s |\n",

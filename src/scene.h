@@ -16,7 +16,8 @@
 extern "C" {
 #endif
 
-typedef enum { SP_MESH_RECTANGLE = 0, SP_MESH_ELLIPSE = 1 } sp_mesh_kind;
+/** The domain: 2D rectangle or ellipse, 3D box (hexahedra). */
+typedef enum { SP_MESH_RECTANGLE = 0, SP_MESH_ELLIPSE = 1, SP_MESH_BOX = 2 } sp_mesh_kind;
 typedef enum { SP_PROFILE_TANH = 0, SP_PROFILE_SHARP = 1 } sp_profile_kind;
 typedef enum { SP_JAC_AD = 0, SP_JAC_HAND = 1, SP_JAC_FD = 2 } sp_jacobian_kind;
 /** Newton's initial guess: the last state, or extrapolated from the last two. */
@@ -37,9 +38,11 @@ typedef enum {
 
 /** mesh: the domain and its discretisation. */
 typedef struct {
-  sp_mesh_kind type;   /**< rectangle | ellipse */
-  double x0, y0, x1, y1; /**< rectangle corners */
-  int nx, ny;          /**< rectangle elements per direction */
+  sp_mesh_kind type;   /**< rectangle | ellipse | box */
+  double x0, y0, x1, y1; /**< rectangle (and box) corners */
+  int nx, ny;          /**< rectangle (and box) elements per direction */
+  double z0, z1;       /**< box: bottom and top */
+  int nz;              /**< box: elements along z */
   int refinements;     /**< ellipse: five-patch disk refined r times */
   double semi_x, semi_y; /**< ellipse semi-axes (x, y) */
   int buffer_layers;   /**< ellipse: element rings of the buffer (0 = none) */
@@ -81,6 +84,8 @@ typedef struct {
 /** One initial cell. */
 typedef struct {
   double x, y;     /**< centre */
+  double z;        /**< centre z: given on a 3D mesh (a sphere), NaN (not
+                        given) on a 2D one */
   double radius;   /**< radius of the c = 1/2 level set */
   sp_profile_kind profile; /**< tanh (equilibrium width) or sharp */
 } sp_scene_cell;
@@ -242,6 +247,9 @@ int sp_scene_first_difference(const sp_scene *a, const sp_scene *b,
 /** @brief A scene file's text (malloc'd, NUL-terminated, @p len bytes
  *         without the NUL), for sp_scene_load_text. */
 int sp_scene_read_file(const char *path, char **text, size_t *len);
+
+/** @brief The dimension of the scene's mesh: 3 for mesh.type box, else 2. */
+int sp_scene_dim(const sp_scene *scene);
 
 /** @brief Interface width d = sqrt(kappa / (2 alpha)) of the scene's model. */
 double sp_scene_interface_width(const sp_scene *scene);

@@ -49,6 +49,8 @@ static int node_elements(struct sp_support_s *s) {
 }
 
 int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_support *out) {
+  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
+           "layout.support: local supports are not yet on a 3D mesh (issue 29)");
   SP_CHECK(params->margin > 0 && params->band > 0 && params->band < params->margin,
            SP_ERR_INPUT, "layout: need 0 < band (%g) < margin (%g)", params->band,
            params->margin);

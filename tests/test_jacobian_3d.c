@@ -1,0 +1,126 @@
+/* The element Jacobians on hexahedra (3D, issue 29), as tight as the 2D
+ * tests (test_jacobian.c, test_jacobian_hand.c) assert them:
+ *  - on random states with 1, 2 and 3 cells (SFad 16 and 32 unknowns, and
+ *    DFad at 48), on a box of hexahedra whose nodes are moved at random
+ *    (no two faces parallel) with a buffer layer, with a source present:
+ *    hand = AD to 1e-12, AD = central differences to 1e-6, hand = FD to
+ *    1e-6, DFad = AD to 1e-12;
+ *  - a backward-Euler step of two touching spheres solved with the AD and
+ *    with the hand Jacobian takes the same Newton iterations to the same
+ *    state (1e-10). */
+#include "fixtures.h"
+
+static double compare(sp_solver s, const sp_step_data *data, const double *state, int a,
+                      int b) {
+  double diff = -1;
+  if (sp_solver_compare_jacobians(s, data, state, a, b, &diff) != 0) {
+    fprintf(stderr, "compare_jacobians: %s\n", sp_solver_last_error(s));
+    return -1;
+  }
+  return diff;
+}
+
+/* A 4 x 3 x 3 box with every node moved by up to 0.15 of an element, and
+ * its top layer of elements a buffer. */
+static sp_mesh *distorted_box(void) {
+  sp_mesh *mesh;
+  CHECK_OK(sp_mesh_box(0, 0, 0, 0.4, 0.3, 0.3, 4, 3, 3, &mesh));
+  unsigned long long rng = 5;
+  for (int i = 0; i < 3 * mesh->n_nodes; ++i) mesh->xy[i] += 0.015 * sp_random_symmetric(&rng);
+  for (int e = 0; e < mesh->n_elems; ++e)
+    if (e >= 4 * 3 * 2) mesh->region[e] = SP_REGION_BUFFER;
+  return mesh;
+}
+
+static void random_state(const sp_mesh *mesh, int n_cells, unsigned long long seed) {
+  sp_layout *layout;
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, n_cells, &layout));
+  sp_solver s = make_solver(mesh, layout, SP_SOLVER_JAC_HAND);
+  const int n = 2 * layout->n_pairs;
+  double *state = malloc(n * sizeof(double)), *old = malloc(n * sizeof(double));
+  double *source = malloc(layout->n_pairs * sizeof(double));
+  unsigned long long rng = seed;
+  for (int i = 0; i < n; ++i) {
+    /* c in [-0.1, 1.1] (beyond the wells too), mu in [-5, 5] */
+    state[i] = i % 2 == 0 ? 0.5 + 0.6 * sp_random_symmetric(&rng) : 5 * sp_random_symmetric(&rng);
+    old[i] = 0.5 + 0.5 * sp_random_symmetric(&rng);
+  }
+  for (int p = 0; p < layout->n_pairs; ++p) source[p] = 50 * sp_random_symmetric(&rng);
+  sp_step_data data = {.dt = 1e-3, .model = paper_model(), .state_old = old, .source = source};
+  const double hand_ad = compare(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD);
+  const double ad_fd = compare(s, &data, state, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD);
+  const double hand_fd = compare(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD);
+  const double dfad_ad = compare(s, &data, state, SP_SOLVER_JAC_AD_DFAD, SP_SOLVER_JAC_AD);
+  printf("hexahedra, random, %d cell%s: hand vs ad %.3g, ad vs fd %.3g, hand vs fd %.3g, "
+         "dfad vs ad %.3g\n",
+         n_cells, n_cells > 1 ? "s" : "", hand_ad, ad_fd, hand_fd, dfad_ad);
+  CHECK(hand_ad >= 0 && hand_ad < 1e-12, "%d cells: hand vs ad %g", n_cells, hand_ad);
+  CHECK(ad_fd >= 0 && ad_fd < 1e-6, "%d cells: ad vs fd %g", n_cells, ad_fd);
+  CHECK(hand_fd >= 0 && hand_fd < 1e-6, "%d cells: hand vs fd %g", n_cells, hand_fd);
+  CHECK(dfad_ad >= 0 && dfad_ad < 1e-12, "%d cells: dfad vs ad %g", n_cells, dfad_ad);
+  sp_solver_destroy(&s);
+  sp_layout_destroy(&layout);
+  free(state); free(old); free(source);
+}
+
+/* c_k = tanh sphere of radius R at (x, y, z) with width d; mu_k = 0. */
+static void set_sphere(const sp_mesh *mesh, const sp_layout *layout, double *state, int k,
+                       const double centre[3], double R, double d) {
+  for (int i = 0; i < mesh->n_nodes; ++i) {
+    const int p = sp_layout_pair(layout, k, i);
+    if (p < 0) continue;
+    const double *x = mesh->xy + 3 * i;
+    const double r = sqrt((x[0] - centre[0]) * (x[0] - centre[0]) +
+                          (x[1] - centre[1]) * (x[1] - centre[1]) +
+                          (x[2] - centre[2]) * (x[2] - centre[2]));
+    state[2 * p] = 1.0 / (1.0 + exp((r - R) / d));
+    state[2 * p + 1] = 0.0;
+  }
+}
+
+/* One step from two touching spheres with each Jacobian: same iterations,
+ * same state. */
+static void newton_step(void) {
+  sp_mesh *mesh;
+  CHECK_OK(sp_mesh_box(0, 0, 0, 0.5, 0.4, 0.4, 10, 8, 8, &mesh));
+  sp_layout *layout;
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 2, &layout));
+  const int n = 2 * layout->n_pairs, kinds[2] = {SP_SOLVER_JAC_AD, SP_SOLVER_JAC_HAND};
+  double *start = calloc(n, sizeof(double)), *result[2];
+  const double d = sqrt(4e-3 / 8), a[3] = {0.16, 0.2, 0.2}, b[3] = {0.34, 0.21, 0.19};
+  set_sphere(mesh, layout, start, 0, a, 0.1, d);
+  set_sphere(mesh, layout, start, 1, b, 0.08, d);
+  sp_model_params model = paper_model();
+  model.kappa = 4e-3;
+  int its[2];
+  for (int j = 0; j < 2; ++j) {
+    sp_solver s = make_solver_with(mesh, layout, kinds[j], SP_SOLVER_MUMPS);
+    result[j] = malloc(n * sizeof(double));
+    memcpy(result[j], start, n * sizeof(double));
+    sp_step_data data = {.dt = 2e-4, .model = model, .state_old = start};
+    sp_step_report rep;
+    CHECK(sp_solver_step(s, &data, result[j], &rep) == 0, "%s step: %s", j ? "hand" : "ad",
+          sp_solver_last_error(s));
+    its[j] = rep.newton_its;
+    sp_solver_destroy(&s);
+  }
+  double diff = 0;
+  for (int i = 0; i < n; ++i) diff = fmax(diff, fabs(result[0][i] - result[1][i]));
+  printf("two spheres, one step: Newton iterations ad %d, hand %d; states differ by %.3g\n",
+         its[0], its[1], diff);
+  CHECK(its[0] == its[1], "Newton iterations: ad %d, hand %d", its[0], its[1]);
+  CHECK(diff < 1e-10, "the states differ by %g", diff);
+  free(start); free(result[0]); free(result[1]);
+  sp_layout_destroy(&layout);
+  sp_mesh_destroy(&mesh);
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  sp_mesh *mesh = distorted_box();
+  for (int n_cells = 1; n_cells <= 3; ++n_cells) random_state(mesh, n_cells, 23 + n_cells);
+  sp_mesh_destroy(&mesh);
+  newton_step();
+  MPI_Finalize();
+  TEST_DONE();
+}

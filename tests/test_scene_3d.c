@@ -1,0 +1,100 @@
+/* Scenes on a 3D mesh (mesh.type box, issue 29 phase 1):
+ *  - a box scene with spheres loads: dimension 3, the cells' z, the box's
+ *    z0, z1, nz;
+ *  - bad 3D input is refused as bad input (SP_ERR_INPUT) with a message
+ *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
+ *    the box, a z on a 2D mesh, and each feature not yet in 3D (division,
+ *    shape term, local supports explicit or by auto with 5 cells,
+ *    pictures, checkpoints, initial fields from files) with "not yet";
+ *  - `softpack run` of such a scene exits 2, names the key and writes
+ *    nothing. */
+#include <string.h>
+#include <sys/stat.h>
+
+#include "check.h"
+#include "command.h"
+#include "error.h"
+#include "scene.h"
+
+static const char good_mesh[] =
+    "mesh: {type: box, x0: 0, y0: 0, z0: -0.1, x1: 0.6, y1: 0.5, z1: 0.4, nx: 6, ny: 5, nz: 5}\n";
+static const char good_output[] = "output: {pictures: false}\n";
+static const char good_cells[] =
+    "cells:\n"
+    "  - {x: 0.3, y: 0.25, z: 0.15, radius: 0.1}\n";
+
+/* The good scene with @p extra appended (more cells, or sections; an
+ * output section replaces the good one), its mesh line @p mesh if given. */
+static int load(const char *mesh, const char *extra, sp_scene **out) {
+  char text[2048];
+  snprintf(text, sizeof text, "%s%s%s%s", mesh ? mesh : good_mesh,
+           strstr(extra, "output:") ? "" : good_output, good_cells, extra);
+  return sp_scene_load_text("bad3d.yaml", text, strlen(text), 0, NULL, out);
+}
+
+static void refused(const char *mesh, const char *extra, const char *key, const char *also) {
+  sp_scene *scene = NULL;
+  const int rc = load(mesh, extra, &scene);
+  const char *msg = sp_error_message();
+  printf("refused: %s\n", msg);
+  CHECK(rc == SP_ERR_INPUT && !scene, "accepted (rc %d) with %s%s", rc, mesh ? mesh : "", extra);
+  CHECK(strstr(msg, key) != NULL, "the message does not name %s: %s", key, msg);
+  CHECK(!also || strstr(msg, also) != NULL, "the message does not say '%s': %s", also, msg);
+  sp_scene_destroy(&scene);
+}
+
+int main(void) {
+  sp_scene *scene;
+  CHECK_OK(load(NULL, "", &scene));
+  CHECK(sp_scene_dim(scene) == 3 && scene->mesh.type == SP_MESH_BOX, "dimension %d",
+        sp_scene_dim(scene));
+  CHECK(scene->mesh.z0 == -0.1 && scene->mesh.z1 == 0.4 && scene->mesh.nz == 5,
+        "box z: %g %g %d", scene->mesh.z0, scene->mesh.z1, scene->mesh.nz);
+  CHECK(scene->cells[0].z == 0.15, "cells[0].z = %g", scene->cells[0].z);
+  sp_scene_destroy(&scene);
+
+  const char *box_low =
+      "mesh: {type: box, x0: 0, y0: 0, z0: 0.4, x1: 0.6, y1: 0.5, z1: 0.4, nx: 6, ny: 5, nz: 5}\n";
+  refused(box_low, "", "mesh.z1", NULL);
+  const char *box = "mesh: {type: box, x1: 0.6, y1: 0.5, z0: -0.1, z1: 0.4, nz: 5}\n";
+  refused(box, "  - {x: 0.3, y: 0.25, radius: 0.1}\n", "cells[1].z", "required");
+  refused(box, "  - {x: 0.3, y: 0.25, z: 0.35, radius: 0.1}\n", "cells[1].radius", "sphere");
+  refused(box, "  - {x: 0.3, y: 0.25, z: 0.5, radius: 0.1}\n", "cells[1].z", "outside");
+  refused("mesh: {type: rectangle, x1: 0.6, y1: 0.5}\n", "", "cells[0].z", "3D mesh");
+  refused(NULL, "division: {criterion: age}\n", "division.criterion", "not yet in 3D");
+  refused(NULL, "shape: {delta2: 1e5}\n", "shape.delta2", "not yet in 3D");
+  refused(NULL, "layout: {support: local}\n", "layout.support", "not yet in 3D");
+  refused(NULL,
+          "  - {x: 0.1, y: 0.1, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.1, z: 0.0, radius: 0.05}\n"
+          "  - {x: 0.1, y: 0.4, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.4, z: 0.0, radius: 0.05}\n",
+          "layout.support", "not yet in 3D");
+  refused(NULL, "output: {pictures: true}\n", "output.pictures", "not yet in 3D");
+  refused(NULL, "output: {pictures: false, checkpoint_every: 5}\n", "output.checkpoint_every",
+          "not yet in 3D");
+  refused(NULL, "output: {pictures: false, checkpoint_seconds: 60}\n",
+          "output.checkpoint_seconds", "not yet in 3D");
+  refused(NULL, "initial: {from: run.h5}\n", "initial.from", "not yet in 3D");
+  refused(NULL, "initial: {label_image: cells.png}\n", "initial.label_image", "not yet in 3D");
+
+  /* the program: exit 2, the key named, nothing written */
+  FILE *f = fopen("test_scene_3d.yaml", "w");
+  CHECK(f != NULL, "cannot write the scene");
+  fprintf(f, "%s%s%sdivision: {criterion: mass}\n", good_mesh, good_output, good_cells);
+  fclose(f);
+  char out[4096];
+  const int status =
+      run_softpack("run test_scene_3d.yaml --quiet --out test_scene_3d_out", out, sizeof out);
+  struct stat st;
+  printf("softpack run: exit %d: %s", status, out);
+  CHECK(status == 2, "exit status %d: %s", status, out);
+  CHECK(strstr(out, "division.criterion") && strstr(out, "not yet in 3D"), "output: %s", out);
+  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+  /* --set turns the pictures on: refused the same way */
+  const int status2 = run_softpack(
+      "run " SP_SOURCE_DIR "/tests/scenes/sphere_3d.yaml --quiet --out test_scene_3d_out "
+      "--set output.pictures=true",
+      out, sizeof out);
+  CHECK(status2 == 2 && strstr(out, "output.pictures"), "exit %d: %s", status2, out);
+  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+  TEST_DONE();
+}
