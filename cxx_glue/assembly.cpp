@@ -164,6 +164,33 @@ bool Assembly::same_layout(const sp_layout_view &l) const {
          std::equal(pair_cell_.begin(), pair_cell_.end(), l.pair_cell);
 }
 
+namespace {
+
+// Element e's unknowns and step inputs, slot-major, on an element of NEN
+// nodes (a compile-time count: the loops of a one-cell element are a few
+// dozen loads, where run-time bounds cost as much as the work).
+template <int NEN>
+void gather_q1(int nc, int64_t s0, const int *slot_pair, const int *slot_cell,
+               const sp_step_data &d, const double *state, std::vector<double> &u,
+               std::vector<double> &c_old, std::vector<double> &source, std::vector<int> &dof,
+               std::vector<const sp_shape_coef *> &shape) {
+  for (int j = 0; j < nc; ++j) {
+    if (d.shape) shape[j] = &d.shape[slot_cell[s0 + j]];
+    for (int a = 0; a < NEN; ++a) {
+      int p = slot_pair[NEN * (s0 + j) + a];
+      if (p < 0) continue;  // outside the support: c = mu = 0, no unknown
+      for (int f = 0; f < 2; ++f) {
+        u[(NEN * j + a) * 2 + f] = state[2 * p + f];
+        dof[(NEN * j + a) * 2 + f] = 2 * p + f;
+      }
+      c_old[NEN * j + a] = d.state_old[2 * p];
+      if (d.source) source[NEN * j + a] = d.source[p];
+    }
+  }
+}
+
+}  // namespace
+
 void Assembly::gather(int e, const sp_step_data &d, const double *state,
                       Gathered &g) const {
   const int nc = n_cells_on(e);
@@ -174,31 +201,24 @@ void Assembly::gather(int e, const sp_step_data &d, const double *state,
   g.source.assign(nen_ * nc, 0.0);
   g.dof.assign(2 * nen_ * nc, -1);
   g.shape.assign(nc, nullptr);
-  for (int j = 0; j < nc; ++j) {
-    if (d.shape) g.shape[j] = &d.shape[slot_cell_[s0 + j]];
-    for (int a = 0; a < nen_; ++a) {
-      int p = slot_pair_[nen_ * (s0 + j) + a];
-      if (p < 0) continue;  // outside the support: c = mu = 0, no unknown
-      for (int f = 0; f < 2; ++f) {
-        g.u[(nen_ * j + a) * 2 + f] = state[2 * p + f];
-        g.dof[(nen_ * j + a) * 2 + f] = 2 * p + f;
-      }
-      g.c_old[nen_ * j + a] = d.state_old[2 * p];
-      if (d.source) g.source[nen_ * j + a] = d.source[p];
-    }
-  }
+  if (nen_ == 8)
+    gather_q1<8>(nc, s0, slot_pair_.data(), slot_cell_.data(), d, state, g.u, g.c_old, g.source,
+                 g.dof, g.shape);
+  else
+    gather_q1<4>(nc, s0, slot_pair_.data(), slot_cell_.data(), d, state, g.u, g.c_old, g.source,
+                 g.dof, g.shape);
 }
 
 namespace {
 
-// Forward AD of the element residual with Fad type F.
-template <class F>
+// Forward AD of the element residual (of dimension DIM) with Fad type F.
+template <int DIM, class F>
 void ad_element(const ElementGeometry &geo, int nc, const double *u,
                 const ElementInputs &in, double *R, double *K) {
-  const int n = 2 * geo.nodes * nc;
+  const int n = 2 * q1_nodes<DIM>() * nc;
   std::vector<F> uf(n), Rf(n);
   for (int i = 0; i < n; ++i) uf[i] = F(n, i, u[i]);
-  element_residual(geo, nc, uf.data(), in, Rf.data());
+  element_residual_q1<DIM>(geo, nc, uf.data(), in, Rf.data());
   for (int i = 0; i < n; ++i) {
     R[i] = Rf[i].val();
     for (int j = 0; j < n; ++j) K[i * n + j] = Rf[i].dx(j);
@@ -238,19 +258,29 @@ void Assembly::element_matrix(int e, const sp_step_data &d, const Gathered &g,
     hand_element(geo, nc, u, in, R, K);
     return;
   }
+  using DFad = Sacado::Fad::DFad<double>;
   if (kind == SP_SOLVER_JAC_AD_DFAD) {  // benchmark-only: DFad at every size
-    ad_element<Sacado::Fad::DFad<double>>(geo, nc, u, in, R, K);
+    if (dim_ == 3) ad_element<3, DFad>(geo, nc, u, in, R, K);
+    else ad_element<2, DFad>(geo, nc, u, in, R, K);
     return;
   }
   // Statically sized Fad for the element sizes that occur most (1-4 cells
   // on a quadrilateral, 1-2 on a hexahedron: 8 to 32 unknowns), dynamically
   // sized beyond.
-  switch (2 * nen_ * nc) {
-    case 8: ad_element<Sacado::Fad::SFad<double, 8>>(geo, nc, u, in, R, K); break;
-    case 16: ad_element<Sacado::Fad::SFad<double, 16>>(geo, nc, u, in, R, K); break;
-    case 24: ad_element<Sacado::Fad::SFad<double, 24>>(geo, nc, u, in, R, K); break;
-    case 32: ad_element<Sacado::Fad::SFad<double, 32>>(geo, nc, u, in, R, K); break;
-    default: ad_element<Sacado::Fad::DFad<double>>(geo, nc, u, in, R, K); break;
+  if (dim_ == 3) {
+    switch (nc) {
+      case 1: ad_element<3, Sacado::Fad::SFad<double, 16>>(geo, nc, u, in, R, K); break;
+      case 2: ad_element<3, Sacado::Fad::SFad<double, 32>>(geo, nc, u, in, R, K); break;
+      default: ad_element<3, DFad>(geo, nc, u, in, R, K); break;
+    }
+    return;
+  }
+  switch (nc) {
+    case 1: ad_element<2, Sacado::Fad::SFad<double, 8>>(geo, nc, u, in, R, K); break;
+    case 2: ad_element<2, Sacado::Fad::SFad<double, 16>>(geo, nc, u, in, R, K); break;
+    case 3: ad_element<2, Sacado::Fad::SFad<double, 24>>(geo, nc, u, in, R, K); break;
+    case 4: ad_element<2, Sacado::Fad::SFad<double, 32>>(geo, nc, u, in, R, K); break;
+    default: ad_element<2, DFad>(geo, nc, u, in, R, K); break;
   }
 }
 
@@ -300,11 +330,13 @@ void Assembly::jacobian(const sp_step_data &d, const double *state, int kind,
         const int j = i / per_slot, f = i % 2;
         cols.clear();
         vals.clear();
-        for (int i2 = 0; i2 < n; ++i2)
-          if (g.dof[i2] >= 0 && coupled(j, f, i2 / per_slot, i2 % 2)) {
-            cols.push_back(g.dof[i2]);
-            vals.push_back(K[(size_t)i * n + i2]);
-          }
+        // columns i2 = per_slot j2 + k, in order (no division per entry)
+        for (int j2 = 0, i2 = 0; j2 < nc; ++j2)
+          for (int k = 0; k < per_slot; ++k, ++i2)
+            if (g.dof[i2] >= 0 && coupled(j, f, j2, k % 2)) {
+              cols.push_back(g.dof[i2]);
+              vals.push_back(K[(size_t)i * n + i2]);
+            }
         int rc = J.SumIntoGlobalValues(g.dof[i], (int)cols.size(), vals.data(), cols.data());
         if (rc < 0) throw std::runtime_error("Jacobian entry outside the graph");
       }

@@ -15,17 +15,20 @@
 //
 // and every other block is zero (coupled() in assembly.hpp). The pointwise
 // values and derivatives come from physics.hpp. Quadrilaterals and
-// hexahedra alike: the node and point counts are the element's, the local
-// arrays sized for the largest (q1.h).
+// hexahedra alike: a kernel templated on the dimension (as
+// element_residual_q1), chosen per element at run time.
 #include "jacobian_hand.hpp"
 
 #include <vector>
 
 namespace sp {
 
-void hand_element(const ElementGeometry &g, int nc, const double *u,
-                  const ElementInputs &in, double *R, double *K) {
-  const int Q = g.qpoints, nen = g.nodes, dim = g.dim;
+namespace {
+
+template <int DIM>
+void hand_element_q1(const ElementGeometry &g, int nc, const double *u,
+                     const ElementInputs &in, double *R, double *K) {
+  constexpr int Q = q1_nodes<DIM>(), nen = q1_nodes<DIM>(), dim = DIM;
   const int n = 2 * nen * nc;
   const sp_model_params &m = in.model;
   // Per quadrature point and slot: c (for the cross blocks) and the
@@ -35,23 +38,23 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
   double *cq = work.data(), *dq = cq + Q * nc;
 
   // w N_a N_b per point, and the element mass and stiffness matrices.
-  constexpr int QM = SP_Q1_MAX_QPOINTS, NM = SP_Q1_MAX_NODES;
-  double NN[QM][NM][NM], Mab[NM][NM] = {}, Lab[NM][NM] = {};
+  double NN[Q][nen][nen], Mab[nen][nen] = {}, Lab[nen][nen] = {};
   for (int q = 0; q < Q; ++q) {
-    const double w = g.w(q), *N = g.N(q);
+    const double w = g.w_[q], *N = g.N_ + q * nen;
     for (int a = 0; a < nen; ++a)
       for (int b = 0; b < nen; ++b) {
         NN[q][a][b] = w * N[a] * N[b];
         Mab[a][b] += NN[q][a][b];
-        Lab[a][b] += w * grad_dot(g.dNdx(q, a), g.dNdx(q, b), dim);
+        Lab[a][b] += w * grad_dot(g.dNdx_ + (q * nen + a) * dim, g.dNdx_ + (q * nen + b) * dim,
+                                  dim);
       }
   }
 
   // The residual, and the pointwise coefficients of the Jacobian.
   for (int i = 0; i < n; ++i) R[i] = 0.0;
   for (int q = 0; q < Q; ++q) {
-    const double *N = g.N(q);
-    const double w = g.w(q);
+    const double *N = g.N_ + q * nen;
+    const double w = g.w_[q];
     double sum_sq = 0.0;
     for (int j = 0; j < nc; ++j) {
       double c = 0.0;
@@ -61,11 +64,11 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
     }
     for (int j = 0; j < nc; ++j) {
       const double c = cq[q * nc + j];
-      double mu = 0.0, gc[SP_Q1_MAX_DIM] = {0, 0, 0}, gmu[SP_Q1_MAX_DIM] = {0, 0, 0};
+      double mu = 0.0, gc[dim] = {}, gmu[dim] = {};
       double c_old = 0.0, s = 0.0;
       for (int a = 0; a < nen; ++a) {
         const double ca = u[(nen * j + a) * 2], mua = u[(nen * j + a) * 2 + 1];
-        const double *dN = g.dNdx(q, a);
+        const double *dN = g.dNdx_ + (q * nen + a) * dim;
         mu += N[a] * mua;
         for (int d = 0; d < dim; ++d) {
           gc[d] += dN[d] * ca;
@@ -81,11 +84,11 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
         d2 += buffer_d2(m);
       }
       if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
-        local += shape_mu(*in.shape[j], g.x(q)[0], g.x(q)[1]);  // 2D only (scene.c)
+        local += shape_mu(*in.shape[j], g.x_[q * dim], g.x_[q * dim + 1]);  // 2D only (scene.c)
       dq[q * nc + j] = d2;
       const double rate = c - c_old - in.dt * s;
       for (int a = 0; a < nen; ++a) {
-        const double *dN = g.dNdx(q, a);
+        const double *dN = g.dNdx_ + (q * nen + a) * dim;
         R[(nen * j + a) * 2] += w * (N[a] * rate + in.dt * m.mobility * grad_dot(dN, gmu, dim));
         R[(nen * j + a) * 2 + 1] += w * (N[a] * (mu - local) - m.kappa * grad_dot(dN, gc, dim));
       }
@@ -95,7 +98,7 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
   // Diagonal (own-cell) blocks.
   const double dtM = in.dt * m.mobility;
   for (int j = 0; j < nc; ++j) {
-    double d[QM];
+    double d[Q];
     for (int q = 0; q < Q; ++q) d[q] = dq[q * nc + j];
     for (int a = 0; a < nen; ++a) {
       double *Kc = K + (size_t)((nen * j + a) * 2) * n + 2 * nen * j;  // row c, cols of slot j
@@ -114,7 +117,7 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
   // Cross-cell blocks dR_mu[j]/dc_l = dR_mu[l]/dc_j: once per unordered pair.
   for (int j = 0; j < nc; ++j)
     for (int l = j + 1; l < nc; ++l) {
-      double d[QM];
+      double d[Q];
       for (int q = 0; q < Q; ++q)
         d[q] = repulsion_d2_cross(m, cq[q * nc + j], cq[q * nc + l]);
       for (int a = 0; a < nen; ++a) {
@@ -128,6 +131,14 @@ void hand_element(const ElementGeometry &g, int nc, const double *u,
         }
       }
     }
+}
+
+}  // namespace
+
+void hand_element(const ElementGeometry &g, int nc, const double *u,
+                  const ElementInputs &in, double *R, double *K) {
+  if (g.dim == 3) hand_element_q1<3>(g, nc, u, in, R, K);
+  else hand_element_q1<2>(g, nc, u, in, R, K);
 }
 
 }  // namespace sp

@@ -1,6 +1,6 @@
 // The hand-derived element Jacobian of exactly the residual of residual.hpp
-// (solver.jacobian: hand). Same element unknowns ((4 j + a) 2 + f, f = 0 c,
-// 1 mu), same ElementGeometry and ElementInputs.
+// (solver.jacobian: hand). Same element unknowns ((n j + a) 2 + f, n the
+// element's nodes, f = 0 c, 1 mu), same ElementGeometry and ElementInputs.
 #ifndef SP_JACOBIAN_HAND_HPP
 #define SP_JACOBIAN_HAND_HPP
 
@@ -8,7 +8,7 @@
 
 namespace sp {
 
-// Element residual R (n = 8 n_cells entries, as element_residual<double>)
+// Element residual R (2 nodes n_cells entries, as element_residual<double>)
 // and Jacobian K = dR/du (row-major n x n). Only the blocks that coupled()
 // (assembly.hpp) allows are written; the caller zeroes K beforehand, the
 // other blocks are exactly zero.

@@ -2,10 +2,10 @@
 // "Dynamics"), templated on the scalar type so one code gives residuals
 // (double) and AD Jacobians (Sacado Fad).
 //
-// One code for quadrilaterals and hexahedra: the element's node count n
-// (4 or 8), point count and dimension are read at run time from its
-// geometry (q1.h's reference elements), with loops over them; see
-// docs/design.md for why not templates on the element type.
+// One code for quadrilaterals and hexahedra: the kernel is a template on
+// the dimension DIM (2 or 3; nodes and points 2^DIM, q1.h's reference
+// elements), and element_residual dispatches on the element's dimension at
+// run time (docs/design.md says why).
 //
 // Element unknowns, for the n_cells cells present on the element: slot j,
 // local node a, field f (0 = c, 1 = mu) at index (n j + a) 2 + f.
@@ -48,6 +48,9 @@ inline double grad_dot(const double *a, const double *b, int dim) {
   return s;
 }
 
+// Nodes (and Gauss points) of the Q1 element of dimension DIM.
+template <int DIM> constexpr int q1_nodes() { return DIM == 3 ? 8 : 4; }
+
 // Per-step data an element reads besides its unknowns.
 struct ElementInputs {
   const double *c_old;   // nodes x n_cells nodal c^n (slot-major)
@@ -57,17 +60,17 @@ struct ElementInputs {
   sp_model_params model;
 };
 
-template <class S>
-void element_residual(const ElementGeometry &g, int n_cells, const S *u,
-                      const ElementInputs &in, S *R) {
-  const int nen = g.nodes, dim = g.dim;
+template <int DIM, class S>
+void element_residual_q1(const ElementGeometry &g, int n_cells, const S *u,
+                         const ElementInputs &in, S *R) {
+  constexpr int nen = q1_nodes<DIM>(), nq = nen, dim = DIM;
   const int n = 2 * nen * n_cells;
   for (int i = 0; i < n; ++i) R[i] = 0.0;
   const sp_model_params &m = in.model;
   // Per-slot values at one quadrature point.
   std::vector<S> c(n_cells), mu(n_cells), gc(dim * n_cells), gmu(dim * n_cells);
-  for (int q = 0; q < g.qpoints; ++q) {
-    const double *N = g.N(q);
+  for (int q = 0; q < nq; ++q) {
+    const double *N = g.N_ + q * nen;
     S sum_sq = 0.0;
     for (int j = 0; j < n_cells; ++j) {
       c[j] = 0.0; mu[j] = 0.0;
@@ -77,7 +80,7 @@ void element_residual(const ElementGeometry &g, int n_cells, const S *u,
       }
       for (int a = 0; a < nen; ++a) {
         const S &ca = u[(nen * j + a) * 2], &mua = u[(nen * j + a) * 2 + 1];
-        const double *dN = g.dNdx(q, a);
+        const double *dN = g.dNdx_ + (q * nen + a) * dim;
         c[j] += N[a] * ca;
         mu[j] += N[a] * mua;
         for (int d = 0; d < dim; ++d) {
@@ -87,7 +90,7 @@ void element_residual(const ElementGeometry &g, int n_cells, const S *u,
       }
       sum_sq += c[j] * c[j];
     }
-    const double w = g.w(q);
+    const double w = g.w_[q];
     for (int j = 0; j < n_cells; ++j) {
       double c_old = 0.0, s = 0.0;
       for (int a = 0; a < nen; ++a) {
@@ -98,16 +101,16 @@ void element_residual(const ElementGeometry &g, int n_cells, const S *u,
       S local = well_d1(m, c[j]) + repulsion_d1(m, c[j], sum_sq);
       if (g.buffer) local += buffer_d1(m, c[j]);
       if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
-        local += shape_mu(*in.shape[j], g.x(q)[0], g.x(q)[1]);  // 2D only (scene.c)
+        local += shape_mu(*in.shape[j], g.x_[q * dim], g.x_[q * dim + 1]);  // 2D only (scene.c)
       const S rate = c[j] - c_old - in.dt * s;
       const S *gm = &gmu[dim * j], *gcj = &gc[dim * j];
       for (int a = 0; a < nen; ++a) {
         // grad N_a . grad mu and grad N_a . grad c written out per dimension
         // (a loop would store each in a Fad temporary: a copy, or with DFad
         // an allocation, per node and point)
-        const double *dN = g.dNdx(q, a);
+        const double *dN = g.dNdx_ + (q * nen + a) * dim;
         S &Rc = R[(nen * j + a) * 2], &Rmu = R[(nen * j + a) * 2 + 1];
-        if (dim == 2) {
+        if constexpr (DIM == 2) {
           Rc += w * (N[a] * rate + in.dt * m.mobility * (dN[0] * gm[0] + dN[1] * gm[1]));
           Rmu += w * (N[a] * (mu[j] - local) - m.kappa * (dN[0] * gcj[0] + dN[1] * gcj[1]));
         } else {
@@ -119,6 +122,14 @@ void element_residual(const ElementGeometry &g, int n_cells, const S *u,
       }
     }
   }
+}
+
+// The element residual on either element: the kernel for its dimension.
+template <class S>
+void element_residual(const ElementGeometry &g, int n_cells, const S *u,
+                      const ElementInputs &in, S *R) {
+  if (g.dim == 3) element_residual_q1<3>(g, n_cells, u, in, R);
+  else element_residual_q1<2>(g, n_cells, u, in, R);
 }
 
 }  // namespace sp
