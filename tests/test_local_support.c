@@ -246,9 +246,89 @@ static void test_rebuild_growth(void) {
   sp_mesh_destroy(&mesh);
 }
 
+/* The same growth with layout.fill = relax (far_field.h): masses kept to
+ * round-off; new nodes where cell 0 is alone, 9 or more interface widths
+ * from its centre line (4 beyond the old edge), sit at the far field in
+ * equilibrium with the free edge's mu (0.1 everywhere here): the lower
+ * root of f'(c) = mu, to 5% (the tail's exp(-4) remnant); new nodes
+ * inside the neighbour stay below that (held down by the repulsion). */
+static void test_rebuild_relax(void) {
+  sp_mesh *mesh;
+  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 0.6, 80, 48, &mesh));
+  const int nn = mesh->n_nodes;
+  const double kappa = 1e-3, alpha = 4, d = sqrt(kappa / (2 * alpha)), c_e = 0.02, mu = 0.1;
+  sp_layout *full;
+  CHECK_OK(sp_layout_create_full(nn, 2, &full));
+  double *state = calloc(2 * (size_t)full->n_pairs, sizeof(double));
+  const double cx[2] = {0.40, 0.63}, r[2] = {0.12, 0.10};
+  for (int i = 0; i < nn; ++i)
+    for (int k = 0; k < 2; ++k) {
+      const double dist = hypot(mesh->xy[2 * i] - cx[k], mesh->xy[2 * i + 1] - 0.3) - r[k];
+      const double p = 1.0 / (1.0 + exp(dist / d));
+      state[2 * sp_layout_pair(full, k, i)] = p + (1 - p) * (k == 0 ? c_e : 0.0);
+      state[2 * sp_layout_pair(full, k, i) + 1] = mu;
+    }
+  sp_support_params narrow = {.margin = 3 * d, .core_threshold = 0.1, .grow_threshold = 0.1,
+                              .band = 2 * d, .alpha = alpha, .kappa = kappa, .lambda = 100,
+                              .lambda_b = 0, .fill = SP_SUPPORT_FILL_RELAX};
+  sp_support_params wide = narrow;
+  wide.margin = 10 * d;
+  sp_support s_narrow, s_wide;
+  CHECK_OK(sp_support_create(mesh, &narrow, &s_narrow));
+  CHECK_OK(sp_support_create(mesh, &wide, &s_wide));
+  unsigned char *mask = calloc((size_t)nn * 2, 1);
+  CHECK_OK(sp_support_masks(s_narrow, full, state, mask));
+  for (int i = 0; i < nn; ++i) mask[nn + i] = 1;
+  sp_layout *layout, *grown;
+  CHECK_OK(sp_support_layout_from_masks(s_narrow, 2, mask, &layout));
+  double *st = calloc(2 * (size_t)layout->n_pairs, sizeof(double)), *next, correction, dropped;
+  sp_layout_transfer(full, state, layout, st, 0.0);
+  const unsigned char keep[2] = {0, 0};
+  CHECK_OK(sp_support_rebuild(s_wide, layout, st, keep, &grown, &next, &correction, &dropped));
+  double c_ff = 0; /* the lower root of 2 alpha c (c - 1) (2 c - 1) = mu */
+  for (int it = 0; it < 50; ++it)
+    c_ff -= (2 * alpha * c_ff * (c_ff - 1) * (2 * c_ff - 1) - mu) /
+            (2 * alpha * (6 * c_ff * c_ff - 6 * c_ff + 1));
+  sp_cell_obs before[2], after[2];
+  CHECK_OK(sp_cells_observe(mesh, layout, st, 0.0, before));
+  CHECK_OK(sp_cells_observe(mesh, grown, next, 0.0, after));
+  int n_far = 0, n_inside = 0;
+  double worst_far = 0, worst_inside = 0;
+  for (int i = 0; i < nn; ++i) {
+    const int p_new = sp_layout_pair(grown, 0, i);
+    if (p_new < 0 || sp_layout_pair(layout, 0, i) >= 0) continue;
+    const double c = next[2 * p_new], c1 = state[2 * sp_layout_pair(full, 1, i)];
+    const double dist = hypot(mesh->xy[2 * i] - cx[0], mesh->xy[2 * i + 1] - 0.3) - r[0];
+    if (c1 < 1e-3 && dist >= 9 * d) {
+      ++n_far;
+      worst_far = fmax(worst_far, fabs(c - c_ff) / c_ff);
+    } else if (c1 > 0.9) {
+      ++n_inside;
+      worst_inside = fmax(worst_inside, c);
+    }
+  }
+  printf("rebuild (relax): far field c_ff = %.5f; %d new nodes far from the edge within %.2e "
+         "of it (relative), %d inside the neighbour at most %.2e; dropped %.1e\n", c_ff, n_far,
+         worst_far, n_inside, worst_inside, dropped);
+  CHECK(n_far > 0 && n_inside > 0, "the growth must reach both kinds of node (%d, %d)", n_far,
+        n_inside);
+  CHECK(worst_far <= 0.05, "new nodes far from the edge: %.3g from the far field", worst_far);
+  CHECK(worst_inside < c_ff, "new nodes inside the neighbour up to %.3g (c_ff %.3g)",
+        worst_inside, c_ff);
+  CHECK(dropped <= 1e-13, "the rebuild dropped %.3e of the mass", dropped);
+  for (int k = 0; k < 2; ++k)
+    CHECK(fabs(after[k].mass - before[k].mass) <= 1e-13 * before[k].mass,
+          "cell %d mass %.17g -> %.17g", k + 1, before[k].mass, after[k].mass);
+  free(state); free(st); free(next); free(mask);
+  sp_layout_destroy(&full); sp_layout_destroy(&layout); sp_layout_destroy(&grown);
+  sp_support_destroy(&s_narrow); sp_support_destroy(&s_wide);
+  sp_mesh_destroy(&mesh);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   test_rebuild_growth();
+  test_rebuild_relax();
   /* 1. local = full on a short scene with a wide margin */
   const char *full_set[] = {"layout.support=full"};
   const char *wide_set[] = {"layout.margin=40", "layout.band=10"};
