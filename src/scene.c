@@ -460,10 +460,12 @@ static const sp_key sp_keys[] = {
               "beyond the cell's core"),
     KEY_FLOAT(SP_SEC_LAYOUT, "core_threshold", layout.core_threshold, 0.1,
               ABOVE(0.0), BELOW(1.0), "-", "local: the core is c_k >= this"),
-    KEY_FLOAT(SP_SEC_LAYOUT, "grow_threshold", layout.grow_threshold, 0.1,
+    KEY_FLOAT(SP_SEC_LAYOUT, "grow_threshold", layout.grow_threshold, 0.2,
               ABOVE(0.0), BELOW(1.0), "-",
               "local: supports are recomputed when c_k >= this within band "
-              "of a support's edge"),
+              "of a support's edge (0.2; at 0.1 the far field piling up at "
+              "the no-flux edge triggers a change every few steps: "
+              "docs/local-support.md)"),
     KEY_FLOAT(SP_SEC_LAYOUT, "band", layout.band, 4.0, ABOVE(0.0), UNBOUNDED,
               "d", "local: width of that band in interface widths (< margin)"),
     KEY_ENUM(SP_SEC_LAYOUT, "shrink", layout.shrink, SP_SHRINK_ALWAYS, sp_shrink_words,
