@@ -129,8 +129,7 @@ static double update(const sp_far_field_params *p, const far_row *r, const far_r
   for (int q = to->node_start[r->node]; q < to->node_start[r->node + 1]; ++q)
     if (q != r->pair)
       others += state[2 * q] * state[2 * q];
-  /* g(c) = M (f'(c) + 2 lambda S c) + 2 lambda_b M_b c + kappa (K_aa c + off) -
-   * M mu */
+  /* g(c) = M (f'(c) + 2 lambda S c - mu) + 2 lambda_b M_b c + kappa (K_aa c + off) */
   const double c0 = state[2 * r->pair];
   double c = c0;
   for (int it = 0; it < 4; ++it) {

@@ -89,7 +89,8 @@ static int maybe_local_supports(sp_run *run, const sp_scene *scene, int n_cells)
                           .alpha = run->opt.model.alpha, .kappa = run->opt.model.kappa,
                           .lambda = run->opt.model.lambda,
                           .lambda_b = run->opt.model.lambda_b,
-                          .fill = ly->fill == SP_FILL_RELAX ? SP_SUPPORT_FILL_RELAX : SP_SUPPORT_FILL_EDGE};
+                          .fill = ly->fill == SP_FILL_RELAX ? SP_SUPPORT_FILL_RELAX
+                                                            : SP_SUPPORT_FILL_EDGE};
   return sp_support_create(run->mesh, &sp, &run->support);
 }
 
