@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A pinned scene (the paper's settings: fixed dt, backward Euler, SuperLU,
 # no predictor, no Jacobian reuse) against softpack's defaults (adaptive
-# BDF2, MUMPS, linear predictor, jacobian_reuse 0.1) on the same scene, one
+# BDF2, MUMPS, linear predictor, jacobian_reuse 0.1, and the default
+# layout.grow_threshold over the published runs' 0.1) on the same scene, one
 # after the other in one run (docs/benchmarks.md):
 #
 #   bench/defaults_vs_today.sh [SCENE] [OUT]    (default: the paper's run 1,
@@ -15,6 +16,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${BUILD:-build} # the build directory whose programs run
+. bench/lib.sh
 scene=${1:-inputs/paper/constant_volume_16.yaml}
 out=${2:-out/defaults_vs_today}
 export OMP_NUM_THREADS=1
@@ -22,9 +24,11 @@ mkdir -p "$out"
 echo "# bench/defaults_vs_today.sh $scene, $(date -u +%Y-%m-%d), $(nproc --all) cores"
 "$build/softpack" run "$scene" --out "$out/today" --set output.pictures=false \
   > "$out/today.log" 2>&1
+mapfile -t layout_defaults < <(defaults_of layout.grow_threshold)
 "$build/softpack" run "$scene" --out "$out/default" --set output.pictures=false \
   --set time.control=adaptive --set time.scheme=bdf2 --set solver.linear=mumps \
-  --set solver.predictor=linear --set solver.jacobian_reuse=0.1 > "$out/default.log" 2>&1
+  --set solver.predictor=linear --set solver.jacobian_reuse=0.1 \
+  "${layout_defaults[@]}" > "$out/default.log" 2>&1
 read -r s0 f0 x0 w0 _ < <("$build"/bench/bench_compare_runs "$out/today" "$out/today")
 read -r s1 f1 x1 w1 e m c l2 < <("$build"/bench/bench_compare_runs "$out/default" "$out/today")
 printf "| run | steps | factorisations | failed | wall s |\n|---|---|---|---|---|\n"

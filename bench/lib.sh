@@ -1,5 +1,16 @@
 # Shell functions shared by the bench scripts (sourced, not run).
 
+# defaults_of KEY...: the program's defaults of KEY..., as "--set" and
+# "KEY=VALUE" lines from `$build/softpack keys` (one word per line, for
+# mapfile), so a run can take them over what a pinned scene sets.
+defaults_of() {
+  local k
+  for k in "$@"; do
+    "$build/softpack" keys | awk -F'|' -v k="\`$k\`" '{ gsub(/ /, "", $2); gsub(/ /, "", $5) }
+      $2 == k { gsub(/`/, "", $2); print "--set"; print $2 "=" $5 }'
+  done
+}
+
 # scene_without_cells SCENE: print SCENE without its cells list, ready for
 # "cells:" and new "  - {x: ..., y: ..., radius: ...}" lines.
 scene_without_cells() {

@@ -30,6 +30,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${BUILD:-build} # the build directory whose programs run
+. bench/lib.sh
 which=${1:-a}
 case "$which" in
   a) scene=inputs/bench/relax_3.yaml ;;
@@ -53,18 +54,11 @@ dt=$(awk '/^time:/ { if (match($0, /dt: *[0-9.eE+-]+/)) { s = substr($0, RSTART,
 dt=${dt:-2e-4}
 [ "$which" = b ] && [ -z "${REF_TOL:-}" ] && [ -z "$ref_dt" ] &&
   ref_dt=$(awk -v dt="$dt" 'BEGIN { printf "%.10g", dt / 128 }')
-# The program's defaults of KEY...: "--set KEY=VALUE" pairs from `softpack keys`.
-defaults_of() {
-  local k
-  for k in "$@"; do
-    "$build/softpack" keys | awk -F'|' -v k="\`$k\`" '{ gsub(/ /, "", $2); gsub(/ /, "", $5) }
-      $2 == k { gsub(/`/, "", $2); print "--set"; print $2 "=" $5 }'
-  done
-}
 mapfile -t fast < <(defaults_of solver.linear solver.predictor solver.jacobian_reuse \
                       solver.jacobian_carry)
-mapfile -t defaults < <(defaults_of time.control time.scheme time.rtol time.atol)
-[ ${#fast[@]} = 8 ] && [ ${#defaults[@]} = 8 ] ||
+mapfile -t defaults < <(defaults_of time.control time.scheme time.rtol time.atol \
+                          layout.grow_threshold)
+[ ${#fast[@]} = 8 ] && [ ${#defaults[@]} = 10 ] ||
   { echo "bench/work_precision.sh: cannot read the defaults from softpack keys" >&2; exit 2; }
 solver=("${fast[@]}" "${solver[@]}")
 

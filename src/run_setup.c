@@ -86,8 +86,11 @@ static int maybe_local_supports(sp_run *run, const sp_scene *scene, int n_cells)
   const double d = sp_scene_interface_width(scene);
   sp_support_params sp = {.margin = ly->margin * d, .core_threshold = ly->core_threshold,
                           .grow_threshold = ly->grow_threshold, .band = ly->band * d,
-                          .alpha = run->opt.model.alpha, .lambda = run->opt.model.lambda,
-                          .lambda_b = run->opt.model.lambda_b};
+                          .alpha = run->opt.model.alpha, .kappa = run->opt.model.kappa,
+                          .lambda = run->opt.model.lambda,
+                          .lambda_b = run->opt.model.lambda_b,
+                          .fill = ly->fill == SP_FILL_RELAX ? SP_SUPPORT_FILL_RELAX
+                                                            : SP_SUPPORT_FILL_EDGE};
   return sp_support_create(run->mesh, &sp, &run->support);
 }
 

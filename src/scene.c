@@ -155,6 +155,8 @@ static const cyaml_strval_t sp_shape_scheme_words[] = {
     {"explicit", SP_SHAPE_EXPLICIT}, {"implicit", SP_SHAPE_IMPLICIT}};
 static const cyaml_strval_t sp_shrink_words[] = {
     {"divisions", SP_SHRINK_DIVISIONS}, {"always", SP_SHRINK_ALWAYS}};
+static const cyaml_strval_t sp_fill_words[] = {{"edge", SP_FILL_EDGE},
+                                                  {"relax", SP_FILL_RELAX}};
 static const cyaml_strval_t sp_support_words[] = {
     {"auto", SP_SUPPORT_AUTO}, {"full", SP_SUPPORT_FULL}, {"local", SP_SUPPORT_LOCAL}};
 /* The YAML 1.1 booleans; the first word of each value is the one printed. */
@@ -470,10 +472,12 @@ static const sp_key sp_keys[] = {
               "beyond the cell's core"),
     KEY_FLOAT(SP_SEC_LAYOUT, "core_threshold", layout.core_threshold, 0.1,
               ABOVE(0.0), BELOW(1.0), "-", "local: the core is c_k >= this"),
-    KEY_FLOAT(SP_SEC_LAYOUT, "grow_threshold", layout.grow_threshold, 0.1,
+    KEY_FLOAT(SP_SEC_LAYOUT, "grow_threshold", layout.grow_threshold, 0.2,
               ABOVE(0.0), BELOW(1.0), "-",
               "local: supports are recomputed when c_k >= this within band "
-              "of a support's edge"),
+              "of a support's edge (0.2; at 0.1 the far field piling up at "
+              "the no-flux edge triggers a change every few steps: "
+              "docs/local-support.md)"),
     KEY_FLOAT(SP_SEC_LAYOUT, "band", layout.band, 4.0, ABOVE(0.0), UNBOUNDED,
               "d", "local: width of that band in interface widths (< margin)"),
     KEY_ENUM(SP_SEC_LAYOUT, "shrink", layout.shrink, SP_SHRINK_ALWAYS, sp_shrink_words,
@@ -483,6 +487,12 @@ static const sp_key sp_keys[] = {
              "of a division (divisions: no energy rise from dropping "
              "far-field mass, but supports trail moving and growing cells: "
              "many more unknowns in growth runs)"),
+    KEY_ENUM(SP_SEC_LAYOUT, "fill", layout.fill, SP_FILL_EDGE, sp_fill_words, "-",
+             "local: what new (cell, node) pairs of a support change start "
+             "from: the old edge's mean c at the node's stiffness (edge), or "
+             "that relaxed to the far field's equations at the free edge's "
+             "chemical potential (relax: fewer steps with narrow margins, "
+             "docs/local-support.md)"),
     /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
      * in E L^2, so delta is in E / L^6 */
     KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),

@@ -167,6 +167,9 @@ typedef enum { SP_SUPPORT_AUTO = 0, SP_SUPPORT_FULL = 1, SP_SUPPORT_LOCAL = 2 } 
 /** When a local support may shrink (it may always grow). */
 typedef enum { SP_SHRINK_DIVISIONS = 0, SP_SHRINK_ALWAYS = 1 } sp_shrink_kind;
 
+/** What new (cell, node) pairs of a support change start from. */
+typedef enum { SP_FILL_EDGE = 0, SP_FILL_RELAX = 1 } sp_fill_kind;
+
 /** layout: where each cell's field lives. */
 typedef struct {
   sp_support_kind support; /**< auto | full (the paper) | local */
@@ -176,6 +179,7 @@ typedef struct {
   double band;             /**< ... within this many widths of the edge */
   sp_shrink_kind shrink;   /**< local: shrink at every support change, or
                                 only the supports of dividing cells */
+  sp_fill_kind fill;       /**< local: what new pairs of a change start from */
 } sp_scene_layout;
 
 /** How the shape term enters a step (src/shape.h). */

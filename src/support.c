@@ -6,6 +6,7 @@
 
 #include "cells.h"
 #include "error.h"
+#include "far_field.h"
 #include "q1.h"
 
 struct sp_support_s {
@@ -359,6 +360,78 @@ static void continue_far_field(sp_support s, const sp_layout *layout, const doub
     }
 }
 
+/** layout.fill = relax: the far field's own equations relaxed on the new
+ *  pairs (far_field.h) at each cell's free-edge mu, from
+ *  continue_far_field's values. */
+static int relax_new_pairs(sp_support s, const sp_layout *layout, const sp_layout *to,
+                           double *next, const double *mu_far) {
+  unsigned char *is_new;
+  SP_ALLOC(is_new, to->n_pairs);
+  for (int i = 0; i < to->n_nodes; ++i)
+    for (int q = to->node_start[i]; q < to->node_start[i + 1]; ++q)
+      is_new[q] = sp_layout_pair(layout, to->pair_cell[q], i) < 0;
+  const sp_far_field_params fp = {.alpha = s->params.alpha, .kappa = s->params.kappa,
+                                  .lambda = s->params.lambda, .lambda_b = s->params.lambda_b,
+                                  .mu_far = mu_far};
+  const int rc = sp_far_field_relax(s->mesh, s->ne_start, s->ne_list, &fp, to, is_new, next, NULL);
+  free(is_new);
+  return rc;
+}
+
+/** An edge node is free for cell k when no other cell's c exceeds this
+ *  there (and no buffer ring is around it). */
+#define SP_SUPPORT_FREE_C 1e-2
+
+/** Per cell, the mean mu over the free nodes of its old support's edge:
+ *  the far field's chemical potential where the cell is alone (an edge
+ *  inside a neighbour has its mu raised by the repulsion); @p edge_mu keeps
+ *  the whole edge's mean for a cell without free edge nodes. */
+static int free_edge_mu(sp_support s, const sp_layout *layout, const double *state,
+                        double *edge_mu) {
+  const int nc = layout->n_cells;
+  double *sum;
+  SP_ALLOC(sum, 2 * (size_t)nc);
+  double *count = sum + nc;
+  for (int i = 0; i < layout->n_nodes; ++i) {
+    if (buffer_share(s, i) > 0) continue;
+    for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p) {
+      const int k = layout->pair_cell[p];
+      int crowded = 0;
+      for (int q = layout->node_start[i]; q < layout->node_start[i + 1]; ++q)
+        crowded |= q != p && state[2 * q] > SP_SUPPORT_FREE_C;
+      if (crowded || !on_edge(s, layout, k, i)) continue;
+      sum[k] += state[2 * p + 1];
+      count[k] += 1;
+    }
+  }
+  for (int k = 0; k < nc; ++k)
+    if (count[k] > 0) edge_mu[k] = sum[k] / count[k];
+  free(sum);
+  return SP_OK;
+}
+
+int sp_support_fill(sp_support s, const sp_layout *layout, const double *state,
+                    const sp_layout *to, double *next) {
+  const int nc = layout->n_cells;
+  sp_layout_transfer(layout, state, to, next, 0.0);
+  /* per cell, the old support's edge means of c and mu */
+  double *acc = calloc(2 * (size_t)(nc ? nc : 1), sizeof(double));
+  int *n_edge = calloc((size_t)(nc ? nc : 1), sizeof(int));
+  int rc = acc && n_edge ? SP_OK : sp_error_set(SP_ERR_MEMORY, "out of memory filling supports");
+  double *edge_c = acc, *edge_mu = acc + nc;
+  if (rc == SP_OK) {
+    edge_means(s, layout, state, edge_c, edge_mu, n_edge);
+    continue_far_field(s, layout, state, to, next, edge_c, edge_mu);
+  }
+  if (rc == SP_OK && s->params.fill == SP_SUPPORT_FILL_RELAX) {
+    rc = free_edge_mu(s, layout, state, edge_mu);
+    if (rc == SP_OK) rc = relax_new_pairs(s, layout, to, next, edge_mu);
+  }
+  free(acc);
+  free(n_edge);
+  return rc;
+}
+
 /** The interior of a cell, where support changes restore its mass. */
 #define SP_SUPPORT_INTERIOR 0.5
 
@@ -371,28 +444,19 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   *mass_correction = 0;
   *mass_dropped = 0;
   SP_CALL(sp_support_layout(s, layout, state, may_shrink, new_layout));
-  int rc = SP_OK;
   sp_layout *to = *new_layout;
   double *next;
   SP_ALLOC(next, 2 * (size_t)to->n_pairs);
   *new_state = next;
-  sp_layout_transfer(layout, state, to, next, 0.0);
+  int rc = sp_support_fill(s, layout, state, to, next);
   sp_cell_obs *before, *after;
   SP_ALLOC(before, nc);
   SP_ALLOC(after, nc);
-  /* Per cell (every loop below runs over pairs, not cells x nodes):
-   * the old support's edge means of c and mu, then the interior's and the
-   * support's weights. */
-  double *acc = calloc(4 * (size_t)(nc ? nc : 1), sizeof(double));
-  int *n_edge = calloc((size_t)(nc ? nc : 1), sizeof(int));
+  /* per cell: the interior's and the support's weights */
+  double *acc = calloc(2 * (size_t)(nc ? nc : 1), sizeof(double));
   double *w = malloc(sizeof(double) * (size_t)(to->n_pairs ? to->n_pairs : 1));
-  if (!acc || !n_edge || !w) rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
-  double *edge_c = acc, *edge_mu = acc + nc, *w_interior = acc + 2 * (size_t)nc,
-         *w_all = acc + 3 * (size_t)nc;
-  if (rc == SP_OK) {
-    edge_means(s, layout, state, edge_c, edge_mu, n_edge);
-    continue_far_field(s, layout, state, to, next, edge_c, edge_mu);
-  }
+  if (!acc || !w) rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
+  double *w_interior = acc, *w_all = acc + (size_t)nc;
   if (rc == SP_OK) rc = sp_cells_observe(s->mesh, layout, state, 0.0, before);
   if (rc == SP_OK) rc = sp_cells_observe(s->mesh, to, next, 0.0, after);
   /* A shift of c_k by d on a set of nodes changes the mass by d x (their
@@ -428,7 +492,6 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   if (rc == SP_OK)
     *mass_dropped = fabs(total_after - total_before) / (total_before != 0 ? fabs(total_before) : 1);
   free(acc);
-  free(n_edge);
   free(w);
   free(before);
   free(after);

@@ -26,6 +26,12 @@ extern "C" {
 
 typedef struct sp_support_s *sp_support;
 
+/** What new (cell, node) pairs of a support change start from. */
+typedef enum {
+  SP_SUPPORT_FILL_EDGE = 0, /**< the old edge's mean c at the node's stiffness */
+  SP_SUPPORT_FILL_RELAX = 1 /**< that, relaxed to the far field's equations */
+} sp_support_fill_kind;
+
 /** Parameters (lengths in the model's length unit). */
 typedef struct {
   double margin;         /**< support = elements within this of the core */
@@ -34,7 +40,8 @@ typedef struct {
   double band;           /**< ... within this distance of the support edge */
   /* The model (for the far-field value new nodes start from): f''(0) =
    * 2 alpha, the repulsion lambda and the buffer ring's lambda_b. */
-  double alpha, lambda, lambda_b;
+  double alpha, kappa, lambda, lambda_b;
+  sp_support_fill_kind fill; /**< layout.fill */
 } sp_support_params;
 
 /** @brief Node adjacency of a mesh and the parameters. */
@@ -60,6 +67,15 @@ int sp_support_masks(sp_support s, const sp_layout *layout,
  */
 int sp_support_needs_update(sp_support s, const sp_layout *layout,
                             const double *state, int *needed);
+
+/**
+ * @brief The values of @p state (on @p layout) on the layout @p to, each
+ *        cell's mass not yet restored: kept pairs by (cell, node), new
+ *        pairs the far field continued from the old edge
+ *        (sp_support_rebuild's first half).
+ */
+int sp_support_fill(sp_support s, const sp_layout *layout, const double *state,
+                    const sp_layout *to, double *next);
 
 /**
  * @brief New supports from the fields, values moved to them, masses

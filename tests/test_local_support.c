@@ -129,6 +129,60 @@ static sp_run_summary run(const char *scene_file, int n_set, const char **set, c
   return sum;
 }
 
+/** The rebuild scene of the two tests below: cell 0 (a tanh disk with a
+ *  far field c_e = 0.02) on a support of 3 widths, cell 1 everywhere, mu =
+ *  0.1 throughout; rebuilt with a margin of 10 widths (no cell may shrink)
+ *  by @p fill. */
+typedef struct {
+  sp_mesh *mesh;
+  sp_layout *full, *layout, *grown;
+  sp_support s_narrow, s_wide;
+  double *state, *st, *next, correction, dropped;
+  unsigned char *mask;
+} rebuild_case;
+
+static const double rb_cx[2] = {0.40, 0.63}, rb_r[2] = {0.12, 0.10}, rb_c_e = 0.02,
+                    rb_mu = 0.1, rb_kappa = 1e-3, rb_alpha = 4, rb_lambda = 100;
+
+static void rebuild_setup(sp_support_fill_kind fill, rebuild_case *rc) {
+  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 0.6, 80, 48, &rc->mesh));
+  const int nn = rc->mesh->n_nodes;
+  const double d = sqrt(rb_kappa / (2 * rb_alpha));
+  CHECK_OK(sp_layout_create_full(nn, 2, &rc->full));
+  rc->state = calloc(2 * (size_t)rc->full->n_pairs, sizeof(double));
+  for (int i = 0; i < nn; ++i)
+    for (int k = 0; k < 2; ++k) {
+      const double dist =
+          hypot(rc->mesh->xy[2 * i] - rb_cx[k], rc->mesh->xy[2 * i + 1] - 0.3) - rb_r[k];
+      const double p = 1.0 / (1.0 + exp(dist / d));
+      rc->state[2 * sp_layout_pair(rc->full, k, i)] = p + (1 - p) * (k == 0 ? rb_c_e : 0.0);
+      rc->state[2 * sp_layout_pair(rc->full, k, i) + 1] = rb_mu;
+    }
+  sp_support_params narrow = {.margin = 3 * d, .core_threshold = 0.1, .grow_threshold = 0.1,
+                              .band = 2 * d, .alpha = rb_alpha, .kappa = rb_kappa,
+                              .lambda = rb_lambda, .lambda_b = 0, .fill = fill};
+  sp_support_params wide = narrow;
+  wide.margin = 10 * d;
+  CHECK_OK(sp_support_create(rc->mesh, &narrow, &rc->s_narrow));
+  CHECK_OK(sp_support_create(rc->mesh, &wide, &rc->s_wide));
+  rc->mask = calloc((size_t)nn * 2, 1);
+  CHECK_OK(sp_support_masks(rc->s_narrow, rc->full, rc->state, rc->mask));
+  for (int i = 0; i < nn; ++i) rc->mask[nn + i] = 1; /* cell 1 everywhere */
+  CHECK_OK(sp_support_layout_from_masks(rc->s_narrow, 2, rc->mask, &rc->layout));
+  rc->st = calloc(2 * (size_t)rc->layout->n_pairs, sizeof(double));
+  sp_layout_transfer(rc->full, rc->state, rc->layout, rc->st, 0.0);
+  const unsigned char keep[2] = {0, 0};
+  CHECK_OK(sp_support_rebuild(rc->s_wide, rc->layout, rc->st, keep, &rc->grown, &rc->next,
+                              &rc->correction, &rc->dropped));
+}
+
+static void rebuild_free(rebuild_case *rc) {
+  free(rc->state); free(rc->st); free(rc->next); free(rc->mask);
+  sp_layout_destroy(&rc->full); sp_layout_destroy(&rc->layout); sp_layout_destroy(&rc->grown);
+  sp_support_destroy(&rc->s_narrow); sp_support_destroy(&rc->s_wide);
+  sp_mesh_destroy(&rc->mesh);
+}
+
 /* sp_support_rebuild on its own: cell 0 (a disk with a far field c_e =
  * 0.02) on a support of 3 interface widths grows to 10 widths, into its
  * neighbour cell 1. Checked: with may_shrink = 0 every old node is kept;
@@ -139,37 +193,14 @@ static sp_run_summary run(const char *scene_file, int n_set, const char **set, c
  * 2 alpha / (2 alpha + 2 lambda 0.81) ~ 1/21. The one-pass pair weights
  * the rebuild uses equal each cell's node weights exactly. */
 static void test_rebuild_growth(void) {
-  sp_mesh *mesh;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 0.6, 80, 48, &mesh));
+  rebuild_case rc;
+  rebuild_setup(SP_SUPPORT_FILL_EDGE, &rc);
+  const sp_mesh *mesh = rc.mesh;
   const int nn = mesh->n_nodes;
-  const double d = sqrt(1e-3 / 8.0), c_e = 0.02, alpha = 4, lambda = 100;
-  sp_layout *full;
-  CHECK_OK(sp_layout_create_full(nn, 2, &full));
-  double *state = calloc(2 * (size_t)full->n_pairs, sizeof(double));
-  const double cx[2] = {0.40, 0.63}, r[2] = {0.12, 0.10};
-  for (int i = 0; i < nn; ++i)
-    for (int k = 0; k < 2; ++k) {
-      const double dist = hypot(mesh->xy[2 * i] - cx[k], mesh->xy[2 * i + 1] - 0.3) - r[k];
-      const double p = 1.0 / (1.0 + exp(dist / d));
-      state[2 * sp_layout_pair(full, k, i)] = p + (1 - p) * (k == 0 ? c_e : 0.0);
-      state[2 * sp_layout_pair(full, k, i) + 1] = 0.1;
-    }
-  sp_support_params narrow = {.margin = 3 * d, .core_threshold = 0.1, .grow_threshold = 0.1,
-                              .band = 2 * d, .alpha = alpha, .lambda = lambda, .lambda_b = 0};
-  sp_support_params wide = narrow;
-  wide.margin = 10 * d;
-  sp_support s_narrow, s_wide;
-  CHECK_OK(sp_support_create(mesh, &narrow, &s_narrow));
-  CHECK_OK(sp_support_create(mesh, &wide, &s_wide));
-  unsigned char *mask = calloc((size_t)nn * 2, 1);
-  CHECK_OK(sp_support_masks(s_narrow, full, state, mask));
-  for (int i = 0; i < nn; ++i) mask[nn + i] = 1; /* cell 1 everywhere */
-  sp_layout *layout, *grown;
-  CHECK_OK(sp_support_layout_from_masks(s_narrow, 2, mask, &layout));
-  double *st = calloc(2 * (size_t)layout->n_pairs, sizeof(double)), *next, correction, dropped;
-  sp_layout_transfer(full, state, layout, st, 0.0);
-  const unsigned char keep[2] = {0, 0};
-  CHECK_OK(sp_support_rebuild(s_wide, layout, st, keep, &grown, &next, &correction, &dropped));
+  const double c_e = rb_c_e, alpha = rb_alpha, lambda = rb_lambda;
+  const sp_layout *full = rc.full, *layout = rc.layout, *grown = rc.grown;
+  const double *state = rc.state, *st = rc.st, *next = rc.next, correction = rc.correction,
+               dropped = rc.dropped;
   printf("rebuild: total mass dropped %.2e (relative)\n", dropped);
   CHECK(dropped <= 1e-13, "the rebuild dropped %.3e of the mass", dropped);
   sp_cell_obs before[2], after[2];
@@ -240,15 +271,65 @@ static void test_rebuild_growth(void) {
   CHECK(weights_differ == 0, "%d pair weights differ from the cells' node weights",
         weights_differ);
   free(w_pair); free(w_node);
-  free(state); free(st); free(next); free(mask);
-  sp_layout_destroy(&full); sp_layout_destroy(&layout); sp_layout_destroy(&grown);
-  sp_support_destroy(&s_narrow); sp_support_destroy(&s_wide);
-  sp_mesh_destroy(&mesh);
+  rebuild_free(&rc);
+}
+
+/* The same growth with layout.fill = relax (far_field.h): masses kept to
+ * round-off; new nodes where cell 0 is alone, 9 or more interface widths
+ * from its centre line (4 beyond the old edge), sit at the far field in
+ * equilibrium with the free edge's mu (0.1 everywhere here): the lower
+ * root of f'(c) = mu, to 5% (the tail's exp(-4) remnant); new nodes
+ * inside the neighbour stay below that (held down by the repulsion). */
+static void test_rebuild_relax(void) {
+  rebuild_case rc;
+  rebuild_setup(SP_SUPPORT_FILL_RELAX, &rc);
+  const sp_mesh *mesh = rc.mesh;
+  const int nn = mesh->n_nodes;
+  const double alpha = rb_alpha, mu = rb_mu, d = sqrt(rb_kappa / (2 * rb_alpha));
+  const double *cx = rb_cx, *r = rb_r, *state = rc.state, *next = rc.next, dropped = rc.dropped;
+  const sp_layout *full = rc.full, *layout = rc.layout, *grown = rc.grown;
+  const double *st = rc.st;
+  double c_ff = 0; /* the lower root of 2 alpha c (c - 1) (2 c - 1) = mu */
+  for (int it = 0; it < 50; ++it)
+    c_ff -= (2 * alpha * c_ff * (c_ff - 1) * (2 * c_ff - 1) - mu) /
+            (2 * alpha * (6 * c_ff * c_ff - 6 * c_ff + 1));
+  sp_cell_obs before[2], after[2];
+  CHECK_OK(sp_cells_observe(mesh, layout, st, 0.0, before));
+  CHECK_OK(sp_cells_observe(mesh, grown, next, 0.0, after));
+  int n_far = 0, n_inside = 0;
+  double worst_far = 0, worst_inside = 0;
+  for (int i = 0; i < nn; ++i) {
+    const int p_new = sp_layout_pair(grown, 0, i);
+    if (p_new < 0 || sp_layout_pair(layout, 0, i) >= 0) continue;
+    const double c = next[2 * p_new], c1 = state[2 * sp_layout_pair(full, 1, i)];
+    const double dist = hypot(mesh->xy[2 * i] - cx[0], mesh->xy[2 * i + 1] - 0.3) - r[0];
+    if (c1 < 1e-3 && dist >= 9 * d) {
+      ++n_far;
+      worst_far = fmax(worst_far, fabs(c - c_ff) / c_ff);
+    } else if (c1 > 0.9) {
+      ++n_inside;
+      worst_inside = fmax(worst_inside, c);
+    }
+  }
+  printf("rebuild (relax): far field c_ff = %.5f; %d new nodes far from the edge within %.2e "
+         "of it (relative), %d inside the neighbour at most %.2e; dropped %.1e\n", c_ff, n_far,
+         worst_far, n_inside, worst_inside, dropped);
+  CHECK(n_far > 0 && n_inside > 0, "the growth must reach both kinds of node (%d, %d)", n_far,
+        n_inside);
+  CHECK(worst_far <= 0.05, "new nodes far from the edge: %.3g from the far field", worst_far);
+  CHECK(worst_inside < c_ff, "new nodes inside the neighbour up to %.3g (c_ff %.3g)",
+        worst_inside, c_ff);
+  CHECK(dropped <= 1e-13, "the rebuild dropped %.3e of the mass", dropped);
+  for (int k = 0; k < 2; ++k)
+    CHECK(fabs(after[k].mass - before[k].mass) <= 1e-13 * before[k].mass,
+          "cell %d mass %.17g -> %.17g", k + 1, before[k].mass, after[k].mass);
+  rebuild_free(&rc);
 }
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   test_rebuild_growth();
+  test_rebuild_relax();
   /* 1. local = full on a short scene with a wide margin */
   const char *full_set[] = {"layout.support=full"};
   const char *wide_set[] = {"layout.margin=40", "layout.band=10"};
@@ -303,9 +384,9 @@ int main(int argc, char **argv) {
   check_edge_laws("local_edge", &b);
 
   /* 4. division under local supports */
-  const char *div_set[] = {"layout.support=local"};
+  const char *div_set[] = {"layout.support=local", "layout.grow_threshold=0.1"};
   sp_scene *scene;
-  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 1, div_set, &scene));
+  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 2, div_set, &scene));
   sp_run_summary d;
   CHECK_OK(sp_stepper_run(scene, "local_divide", MPI_COMM_WORLD, &d));
   printf("division, local supports: %d cells, %d divisions, %d support changes, max %ld unknowns; "
