@@ -26,8 +26,9 @@ namespace sp {
 namespace {
 
 template <int DIM>
-void hand_element_q1(const ElementGeometry &g, int nc, const double *u,
+void hand_element_q1(const ElementGeometry &geo, int nc, const double *u,
                      const ElementInputs &in, double *R, double *K) {
+  const LocalGeometry<DIM> g(geo);  // residual.hpp: why a local copy
   constexpr int Q = q1_nodes<DIM>(), nen = q1_nodes<DIM>(), dim = DIM;
   const int n = 2 * nen * nc;
   const sp_model_params &m = in.model;
@@ -40,21 +41,20 @@ void hand_element_q1(const ElementGeometry &g, int nc, const double *u,
   // w N_a N_b per point, and the element mass and stiffness matrices.
   double NN[Q][nen][nen], Mab[nen][nen] = {}, Lab[nen][nen] = {};
   for (int q = 0; q < Q; ++q) {
-    const double w = g.w_[q], *N = g.N_ + q * nen;
+    const double w = g.w[q], *N = g.N[q];
     for (int a = 0; a < nen; ++a)
       for (int b = 0; b < nen; ++b) {
         NN[q][a][b] = w * N[a] * N[b];
         Mab[a][b] += NN[q][a][b];
-        Lab[a][b] += w * grad_dot(g.dNdx_ + (q * nen + a) * dim, g.dNdx_ + (q * nen + b) * dim,
-                                  dim);
+        Lab[a][b] += w * grad_dot(g.dNdx[q][a], g.dNdx[q][b], dim);
       }
   }
 
   // The residual, and the pointwise coefficients of the Jacobian.
   for (int i = 0; i < n; ++i) R[i] = 0.0;
   for (int q = 0; q < Q; ++q) {
-    const double *N = g.N_ + q * nen;
-    const double w = g.w_[q];
+    const double *N = g.N[q];
+    const double w = g.w[q];
     double sum_sq = 0.0;
     for (int j = 0; j < nc; ++j) {
       double c = 0.0;
@@ -68,7 +68,7 @@ void hand_element_q1(const ElementGeometry &g, int nc, const double *u,
       double c_old = 0.0, s = 0.0;
       for (int a = 0; a < nen; ++a) {
         const double ca = u[(nen * j + a) * 2], mua = u[(nen * j + a) * 2 + 1];
-        const double *dN = g.dNdx_ + (q * nen + a) * dim;
+        const double *dN = g.dNdx[q][a];
         mu += N[a] * mua;
         for (int d = 0; d < dim; ++d) {
           gc[d] += dN[d] * ca;
@@ -84,11 +84,11 @@ void hand_element_q1(const ElementGeometry &g, int nc, const double *u,
         d2 += buffer_d2(m);
       }
       if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
-        local += shape_mu(*in.shape[j], g.x_[q * dim], g.x_[q * dim + 1]);  // 2D only (scene.c)
+        local += shape_mu(*in.shape[j], g.x[q][0], g.x[q][1]);  // 2D only (scene.c)
       dq[q * nc + j] = d2;
       const double rate = c - c_old - in.dt * s;
       for (int a = 0; a < nen; ++a) {
-        const double *dN = g.dNdx_ + (q * nen + a) * dim;
+        const double *dN = g.dNdx[q][a];
         R[(nen * j + a) * 2] += w * (N[a] * rate + in.dt * m.mobility * grad_dot(dN, gmu, dim));
         R[(nen * j + a) * 2 + 1] += w * (N[a] * (mu - local) - m.kappa * grad_dot(dN, gc, dim));
       }
