@@ -2,7 +2,8 @@
 # A pinned scene (the paper's settings: fixed dt, backward Euler, SuperLU,
 # no predictor, no Jacobian reuse) against softpack's defaults (adaptive
 # BDF2, MUMPS, linear predictor, jacobian_reuse 0.1, and the default
-# layout.grow_threshold over the published runs' 0.1) on the same scene, one
+# layout.grow_threshold and layout.fill over the published runs' 0.1 and
+# edge) on the same scene, one
 # after the other in one run (docs/benchmarks.md):
 #
 #   bench/defaults_vs_today.sh [SCENE] [OUT]    (default: the paper's run 1,
@@ -24,7 +25,7 @@ mkdir -p "$out"
 echo "# bench/defaults_vs_today.sh $scene, $(date -u +%Y-%m-%d), $(nproc --all) cores"
 "$build/softpack" run "$scene" --out "$out/today" --set output.pictures=false \
   > "$out/today.log" 2>&1
-mapfile -t layout_defaults < <(defaults_of layout.grow_threshold)
+mapfile -t layout_defaults < <(defaults_of layout.grow_threshold layout.fill)
 "$build/softpack" run "$scene" --out "$out/default" --set output.pictures=false \
   --set time.control=adaptive --set time.scheme=bdf2 --set solver.linear=mumps \
   --set solver.predictor=linear --set solver.jacobian_reuse=0.1 \

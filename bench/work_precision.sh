@@ -57,8 +57,8 @@ dt=${dt:-2e-4}
 mapfile -t fast < <(defaults_of solver.linear solver.predictor solver.jacobian_reuse \
                       solver.jacobian_carry)
 mapfile -t defaults < <(defaults_of time.control time.scheme time.rtol time.atol \
-                          layout.grow_threshold)
-[ ${#fast[@]} = 8 ] && [ ${#defaults[@]} = 10 ] ||
+                          layout.grow_threshold layout.fill)
+[ ${#fast[@]} = 8 ] && [ ${#defaults[@]} = 12 ] ||
   { echo "bench/work_precision.sh: cannot read the defaults from softpack keys" >&2; exit 2; }
 solver=("${fast[@]}" "${solver[@]}")
 

@@ -487,12 +487,12 @@ static const sp_key sp_keys[] = {
              "of a division (divisions: no energy rise from dropping "
              "far-field mass, but supports trail moving and growing cells: "
              "many more unknowns in growth runs)"),
-    KEY_ENUM(SP_SEC_LAYOUT, "fill", layout.fill, SP_FILL_EDGE, sp_fill_words, "-",
+    KEY_ENUM(SP_SEC_LAYOUT, "fill", layout.fill, SP_FILL_RELAX, sp_fill_words, "-",
              "local: what new (cell, node) pairs of a support change start "
-             "from: the old edge's mean c at the node's stiffness (edge), or "
-             "that relaxed to the far field's equations at the free edge's "
-             "chemical potential (relax: fewer steps with narrow margins, "
-             "docs/local-support.md)"),
+             "from: the old edge's mean c at the node's stiffness (edge: "
+             "the published runs), or that relaxed to the far field's "
+             "equations at the free edge's chemical potential (relax: far "
+             "fewer steps with narrow margins, docs/local-support.md)"),
     /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
      * in E L^2, so delta is in E / L^6 */
     KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),

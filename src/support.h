@@ -10,7 +10,8 @@
  * its support's edge, every support is recomputed from the current fields
  * (which may also shrink it); values move with (cell, node), new nodes get
  * the far-field value in equilibrium with the old edge's mean chemical
- * potential (sp_support_rebuild), and each cell's mass is then
+ * potential, relaxed to the far field's equations with layout.fill = relax
+ * (far_field.h; sp_support_rebuild), and each cell's mass is then
  * restored exactly by a uniform shift of c_k over its interior (c_k >= 1/2).
  * The mass changes that shift corrects are reported.
  */

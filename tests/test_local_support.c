@@ -384,9 +384,10 @@ int main(int argc, char **argv) {
   check_edge_laws("local_edge", &b);
 
   /* 4. division under local supports */
-  const char *div_set[] = {"layout.support=local", "layout.grow_threshold=0.1"};
+  const char *div_set[] = {"layout.support=local", "layout.grow_threshold=0.1",
+                           "layout.fill=edge"};
   sp_scene *scene;
-  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 2, div_set, &scene));
+  CHECK_OK(sp_scene_load(SP_SOURCE_DIR "/tests/scenes/divide_1_2_4.yaml", 3, div_set, &scene));
   sp_run_summary d;
   CHECK_OK(sp_stepper_run(scene, "local_divide", MPI_COMM_WORLD, &d));
   printf("division, local supports: %d cells, %d divisions, %d support changes, max %ld unknowns; "
