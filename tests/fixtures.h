@@ -65,6 +65,23 @@ static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout
   return make_solver_with(mesh, layout, jacobian, SP_SOLVER_SUPERLU);
 }
 
+/** A random step on @p layout for the Jacobian checks: c in [-0.1, 1.1]
+ *  (beyond the wells too), mu in [-5, 5], c^n in [0, 1], a source in
+ *  [-50, 50]; the three arrays malloc'ed (the caller frees them). */
+static inline void random_step_arrays(const sp_layout *layout, unsigned long long seed,
+                                      double **state, double **old, double **source) {
+  const int n = 2 * layout->n_pairs;
+  *state = malloc(n * sizeof(double));
+  *old = malloc(n * sizeof(double));
+  *source = malloc(layout->n_pairs * sizeof(double));
+  unsigned long long rng = seed;
+  for (int i = 0; i < n; ++i) {
+    (*state)[i] = i % 2 == 0 ? 0.5 + 0.6 * sp_random_symmetric(&rng) : 5 * sp_random_symmetric(&rng);
+    (*old)[i] = 0.5 + 0.5 * sp_random_symmetric(&rng);
+  }
+  for (int p = 0; p < layout->n_pairs; ++p) (*source)[p] = 50 * sp_random_symmetric(&rng);
+}
+
 /** c_k = tanh disk of radius R at (x, y) with width d; mu_k = 0. */
 static inline void set_disk(const sp_mesh *mesh, const sp_layout *layout, double *state, int k,
                             double x, double y, double R, double d) {

@@ -36,16 +36,8 @@ static void random_state(const sp_mesh *mesh, int n_cells, unsigned long long se
   sp_layout *layout;
   CHECK_OK(sp_layout_create_full(mesh->n_nodes, n_cells, &layout));
   sp_solver s = make_solver(mesh, layout, SP_SOLVER_JAC_HAND);
-  const int n = 2 * layout->n_pairs;
-  double *state = malloc(n * sizeof(double)), *old = malloc(n * sizeof(double));
-  double *source = malloc(layout->n_pairs * sizeof(double));
-  unsigned long long rng = seed;
-  for (int i = 0; i < n; ++i) {
-    /* c in [-0.1, 1.1] (beyond the wells too), mu in [-5, 5] */
-    state[i] = i % 2 == 0 ? 0.5 + 0.6 * sp_random_symmetric(&rng) : 5 * sp_random_symmetric(&rng);
-    old[i] = 0.5 + 0.5 * sp_random_symmetric(&rng);
-  }
-  for (int p = 0; p < layout->n_pairs; ++p) source[p] = 50 * sp_random_symmetric(&rng);
+  double *state, *old, *source;
+  random_step_arrays(layout, seed, &state, &old, &source);
   sp_step_data data = {.dt = 1e-3, .model = paper_model(), .state_old = old, .source = source};
   const double hand_ad = compare(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD);
   const double ad_fd = compare(s, &data, state, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD);
