@@ -65,6 +65,19 @@ static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout
   return make_solver_with(mesh, layout, jacobian, SP_SOLVER_SUPERLU);
 }
 
+/** The largest relative difference of Jacobian kinds @p a and @p b at
+ *  @p state (sp_solver_compare_jacobians); -1, with the solver's message
+ *  printed, if the comparison failed. */
+static inline double jacobian_difference(sp_solver s, const sp_step_data *data,
+                                         const double *state, int a, int b) {
+  double diff = -1;
+  if (sp_solver_compare_jacobians(s, data, state, a, b, &diff) != 0) {
+    fprintf(stderr, "compare_jacobians: %s\n", sp_solver_last_error(s));
+    return -1;
+  }
+  return diff;
+}
+
 /** A random step on @p layout for the Jacobian checks: c in [-0.1, 1.1]
  *  (beyond the wells too), mu in [-5, 5], c^n in [0, 1], a source in
  *  [-50, 50]; the three arrays malloc'ed (the caller frees them). */

@@ -10,6 +10,36 @@
 
 #include "check.h"
 
+/* The energy column of an energy.csv: its rows, first and last values,
+ * and the rises between consecutive rows larger than 1e-13 relative. */
+typedef struct {
+  int rows, rises;
+  double first, last, worst_rise;
+} energy_trend;
+
+static inline energy_trend energy_trend_read(const char *path) {
+  energy_trend tr = {0, 0, 0, INFINITY, 0};
+  FILE *f = fopen(path, "r");
+  CHECK(f != NULL, "%s missing", path);
+  char line[2048];
+  CHECK(fgets(line, sizeof line, f) && strstr(line, "energy"), "%s: header", path);
+  while (fgets(line, sizeof line, f)) {
+    int step, its, n;
+    double t, dt, e;
+    CHECK(sscanf(line, "%d,%lf,%lf,%d,%d,%lf", &step, &t, &dt, &its, &n, &e) == 6, "row %s",
+          line);
+    if (tr.rows == 0) tr.first = e;
+    if (e > tr.last + 1e-13 * fabs(tr.last)) {
+      ++tr.rises;
+      if (e - tr.last > tr.worst_rise) tr.worst_rise = e - tr.last;
+    }
+    tr.last = e;
+    ++tr.rows;
+  }
+  fclose(f);
+  return tr;
+}
+
 /* A CSV log with a header line: every value as a double. */
 typedef struct {
   int n_rows, n_cols;

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "output_read.h"
 #include "error.h"
 #include "scene.h"
 #include "stepper.h"
@@ -15,30 +16,12 @@ int main(int argc, char **argv) {
   sp_run_summary sum;
   CHECK_OK(sp_stepper_run(scene, "test_energy_out", MPI_COMM_WORLD, &sum));
   CHECK(sum.steps == 200, "%d steps", sum.steps);
-  FILE *f = fopen("test_energy_out/energy.csv", "r");
-  CHECK(f != NULL, "energy.csv missing");
-  char line[1024];
-  CHECK(fgets(line, sizeof line, f) && strstr(line, "energy"), "header");
-  int rows = 0, rises = 0;
-  double prev = INFINITY, first = 0, worst_rise = 0;
-  while (fgets(line, sizeof line, f)) {
-    int step, its, n;
-    double t, dt, e;
-    CHECK(sscanf(line, "%d,%lf,%lf,%d,%d,%lf", &step, &t, &dt, &its, &n, &e) == 6, "row %s", line);
-    if (rows == 0) first = e;
-    if (e > prev + 1e-13 * fabs(prev)) {
-      ++rises;
-      if (e - prev > worst_rise) worst_rise = e - prev;
-    }
-    prev = e;
-    ++rows;
-  }
-  fclose(f);
-  printf("%d rows, energy %.10g -> %.10g, %d rises (largest %.3g)\n", rows, first, prev, rises,
-         worst_rise);
-  CHECK(rows == 201, "%d energy rows", rows);
-  CHECK(rises == 0, "the energy rose %d times (largest rise %.3g)", rises, worst_rise);
-  CHECK(prev < first, "the energy did not decrease: %g -> %g", first, prev);
+  const energy_trend tr = energy_trend_read("test_energy_out/energy.csv");
+  printf("%d rows, energy %.10g -> %.10g, %d rises (largest %.3g)\n", tr.rows, tr.first,
+         tr.last, tr.rises, tr.worst_rise);
+  CHECK(tr.rows == 201, "%d energy rows", tr.rows);
+  CHECK(tr.rises == 0, "the energy rose %d times (largest rise %.3g)", tr.rises, tr.worst_rise);
+  CHECK(tr.last < tr.first, "the energy did not decrease: %g -> %g", tr.first, tr.last);
   sp_scene_destroy(&scene);
   MPI_Finalize();
   TEST_DONE();

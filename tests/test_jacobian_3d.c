@@ -10,16 +10,6 @@
  *    state (1e-10). */
 #include "fixtures.h"
 
-static double compare(sp_solver s, const sp_step_data *data, const double *state, int a,
-                      int b) {
-  double diff = -1;
-  if (sp_solver_compare_jacobians(s, data, state, a, b, &diff) != 0) {
-    fprintf(stderr, "compare_jacobians: %s\n", sp_solver_last_error(s));
-    return -1;
-  }
-  return diff;
-}
-
 /* A 4 x 3 x 3 box with every node moved by up to 0.15 of an element, and
  * its top layer of elements a buffer. */
 static sp_mesh *distorted_box(void) {
@@ -39,10 +29,10 @@ static void random_state(const sp_mesh *mesh, int n_cells, unsigned long long se
   double *state, *old, *source;
   random_step_arrays(layout, seed, &state, &old, &source);
   sp_step_data data = {.dt = 1e-3, .model = paper_model(), .state_old = old, .source = source};
-  const double hand_ad = compare(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD);
-  const double ad_fd = compare(s, &data, state, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD);
-  const double hand_fd = compare(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD);
-  const double dfad_ad = compare(s, &data, state, SP_SOLVER_JAC_AD_DFAD, SP_SOLVER_JAC_AD);
+  const double hand_ad = jacobian_difference(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD);
+  const double ad_fd = jacobian_difference(s, &data, state, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD);
+  const double hand_fd = jacobian_difference(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD);
+  const double dfad_ad = jacobian_difference(s, &data, state, SP_SOLVER_JAC_AD_DFAD, SP_SOLVER_JAC_AD);
   printf("hexahedra, random, %d cell%s: hand vs ad %.3g, ad vs fd %.3g, hand vs fd %.3g, "
          "dfad vs ad %.3g\n",
          n_cells, n_cells > 1 ? "s" : "", hand_ad, ad_fd, hand_fd, dfad_ad);

@@ -17,22 +17,12 @@
 #include "command.h"
 #include "fixtures.h"
 
-static double compare(sp_solver s, const sp_step_data *data, const double *state, int a,
-                      int b) {
-  double diff = -1;
-  if (sp_solver_compare_jacobians(s, data, state, a, b, &diff) != 0) {
-    fprintf(stderr, "compare_jacobians: %s\n", sp_solver_last_error(s));
-    return -1;
-  }
-  return diff;
-}
-
 /* hand vs ad, ad vs fd and DFad vs ad at one state; checks and prints. */
 static void check_all(sp_solver s, const sp_step_data *data, const double *state,
                       const char *what) {
-  double hand_ad = compare(s, data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD);
-  double ad_fd = compare(s, data, state, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD);
-  double dfad_ad = compare(s, data, state, SP_SOLVER_JAC_AD_DFAD, SP_SOLVER_JAC_AD);
+  double hand_ad = jacobian_difference(s, data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD);
+  double ad_fd = jacobian_difference(s, data, state, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD);
+  double dfad_ad = jacobian_difference(s, data, state, SP_SOLVER_JAC_AD_DFAD, SP_SOLVER_JAC_AD);
   double hand_fd = -1;
   if (sp_solver_check_jacobian(s, data, state, SP_SOLVER_JAC_HAND, &hand_fd) != 0)
     fprintf(stderr, "check_jacobian: %s\n", sp_solver_last_error(s));

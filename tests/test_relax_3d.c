@@ -17,6 +17,7 @@
 
 #include "check.h"
 #include "error.h"
+#include "output_read.h"
 #include "scene.h"
 #include "stepper.h"
 
@@ -39,29 +40,11 @@ static void relax(const char *scene_file, const char *out, int expect_cells) {
   /* energy.csv: never rises, falls overall */
   char path[512], line[2048];
   snprintf(path, sizeof path, "%s/energy.csv", out);
-  FILE *f = fopen(path, "r");
-  CHECK(f != NULL, "%s missing", path);
-  CHECK(fgets(line, sizeof line, f) && strstr(line, "energy"), "energy.csv header");
-  int rows = 0, rises = 0;
-  double prev = INFINITY, first = 0, worst_rise = 0;
-  while (fgets(line, sizeof line, f)) {
-    int step, its, n;
-    double t, dt, e;
-    CHECK(sscanf(line, "%d,%lf,%lf,%d,%d,%lf", &step, &t, &dt, &its, &n, &e) == 6, "row %s",
-          line);
-    if (rows == 0) first = e;
-    if (e > prev + 1e-13 * fabs(prev)) {
-      ++rises;
-      worst_rise = fmax(worst_rise, e - prev);
-    }
-    prev = e;
-    ++rows;
-  }
-  fclose(f);
+  const energy_trend tr = energy_trend_read(path);
 
   /* cells.csv: the 3D header; each cell's mass per step */
   snprintf(path, sizeof path, "%s/cells.csv", out);
-  f = fopen(path, "r");
+  FILE *f = fopen(path, "r");
   CHECK(f != NULL, "%s missing", path);
   CHECK(fgets(line, sizeof line, f) &&
             strcmp(line, "step,t,cell,mass,xc,yc,zc,core_mass,volume\n") == 0,
@@ -97,11 +80,11 @@ static void relax(const char *scene_file, const char *out, int expect_cells) {
   fclose(f);
   printf("%s: %d steps, energy %.10g -> %.10g, %d rises (largest %.3g); largest relative mass "
          "change per step %.3g\n",
-         scene_file, rows - 1, first, prev, rises, worst_rise, worst_mass);
-  CHECK(rows == steps + 1, "%d energy rows", rows);
+         scene_file, tr.rows - 1, tr.first, tr.last, tr.rises, tr.worst_rise, worst_mass);
+  CHECK(tr.rows == steps + 1, "%d energy rows", tr.rows);
   CHECK(cell_rows == (steps + 1) * expect_cells, "%d cells rows", cell_rows);
-  CHECK(rises == 0, "the energy rose %d times (largest rise %.3g)", rises, worst_rise);
-  CHECK(prev < first, "the energy did not decrease: %g -> %g", first, prev);
+  CHECK(tr.rises == 0, "the energy rose %d times (largest rise %.3g)", tr.rises, tr.worst_rise);
+  CHECK(tr.last < tr.first, "the energy did not decrease: %g -> %g", tr.first, tr.last);
 
   /* what is written in 3D */
   snprintf(path, sizeof path, "%s/energy.png", out);
