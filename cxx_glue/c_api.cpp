@@ -55,10 +55,7 @@ int sp_solver_linear_backend(int linear, const char **backend) {
     switch (linear) {
       case SP_SOLVER_SUPERLU: what = sp::superlu_version(); break;
       case SP_SOLVER_SUPERLU_DIST: what = sp::superlu_dist_version(); break;
-      case SP_SOLVER_MUMPS:
-        what = sp::amesos_version("Amesos_Mumps");
-        available = sp::amesos_available("Amesos_Mumps");
-        break;
+      case SP_SOLVER_MUMPS: what = sp::mumps_version(); break;
       case SP_SOLVER_KLU:
         what = sp::amesos_version("Amesos_Klu");
         available = sp::amesos_available("Amesos_Klu");

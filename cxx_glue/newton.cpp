@@ -306,7 +306,7 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       direct = make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS,
                                   options.refine != 0);
       break;
-    case SP_SOLVER_MUMPS: direct = make_amesos(comm, "Amesos_Mumps"); break;
+    case SP_SOLVER_MUMPS: direct = make_mumps(comm); break;
     case SP_SOLVER_KLU: direct = make_amesos(comm, "Amesos_Klu"); break;
     case SP_SOLVER_KLU2:
       // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
