@@ -94,8 +94,8 @@ std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, 
 // MUMPS through its own C interface (dmumps_c) on the rows as they are
 // distributed (linear_mumps.cpp).
 std::unique_ptr<DirectSolver> make_mumps(MPI_Comm comm);
-// Amesos (v1) on an Epetra copy of the rows: which = "Amesos_Klu" (or
-// "Amesos_Mumps", no longer used). Throws if Amesos was built without it.
+// Amesos (v1) on an Epetra copy of the rows: which = "Amesos_Klu". Throws
+// if Amesos was built without it.
 std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &which);
 // KLU2 through Amesos2 on an Epetra copy of the rows; one process only
 // (throws on several: Debian 13.2's Amesos2 is wrong there, STACK.md).
@@ -120,7 +120,7 @@ const char *superlu_version();
 const char *superlu_dist_version();
 const char *mumps_version();
 const char *amesos_version(const std::string &which);
-// Whether this Trilinos' Amesos was built with "Amesos_Mumps", "Amesos_Klu".
+// Whether this Trilinos' Amesos was built with "Amesos_Klu".
 bool amesos_available(const std::string &which);
 const char *amesos2_klu2_version();
 bool amesos2_klu2_available();

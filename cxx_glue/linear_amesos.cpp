@@ -1,4 +1,4 @@
-// Amesos (v1) direct solvers (MUMPS, KLU) on the caller's Epetra matrix
+// Amesos (v1) direct solvers (KLU; MUMPS has its own, linear_mumps.cpp) on the caller's Epetra matrix
 // when it has one that is the rows (the Jacobian on one process), else on
 // an Epetra copy of the CSR rows (epetra_rows.hpp), built once per pattern
 // with SymbolicFactorization() once; each factor() overwrites the copy's
@@ -7,7 +7,6 @@
 // step every time).
 #include <Amesos.h>
 #include <Amesos_BaseSolver.h>
-#include <Amesos_Mumps.h>
 #include <Epetra_CrsMatrix.h>
 #include <Epetra_LinearProblem.h>
 #include <Epetra_Vector.h>
@@ -110,16 +109,7 @@ class AmesosSolver final : public DirectSolver {
     params.set("PrintStatus", false);
     params.set("ComputeTrueResidual", false);
     params.set("OutputLevel", 0);
-    // MUMPS on every process of the communicator (the default, -1, picks a
-    // subset from MPI_COMM_WORLD, which is wrong for any other communicator).
-    params.set("MaxProcs", -3);
     solver_->SetParameters(params);
-    if (auto *mumps = dynamic_cast<Amesos_Mumps *>(solver_.get())) {
-      mumps->SetICNTL(14, 100);  // workspace relaxation (%): delayed pivots need room
-      // Amesos 13.2 copies all five CNTL values into MUMPS, unset ones as
-      // -123456.789: give the pivoting threshold MUMPS' own default.
-      mumps->SetCNTL(1, 0.01);
-    }
     const int err = solver_->SymbolicFactorization();
     ++symbolic_;
     if (err != 0) {
@@ -151,7 +141,6 @@ std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &whic
 bool amesos_available(const std::string &which) { return Amesos().Query(which); }
 
 const char *amesos_version(const std::string &which) {
-  if (which == "Amesos_Mumps") return "MUMPS " MUMPS_VERSION " through Amesos";
   if (which == "Amesos_Klu") return "Amesos' own KLU (gathered on rank 0 under MPI)";
   return "unknown";
 }
