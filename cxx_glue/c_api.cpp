@@ -56,10 +56,7 @@ int sp_solver_linear_backend(int linear, const char **backend) {
       case SP_SOLVER_SUPERLU: what = sp::superlu_version(); break;
       case SP_SOLVER_SUPERLU_DIST: what = sp::superlu_dist_version(); break;
       case SP_SOLVER_MUMPS: what = sp::mumps_version(); break;
-      case SP_SOLVER_KLU:
-        what = sp::amesos_version("Amesos_Klu");
-        available = sp::amesos_available("Amesos_Klu");
-        break;
+      case SP_SOLVER_KLU: what = sp::klu_version(); break;
       case SP_SOLVER_KLU2:
         what = sp::amesos2_klu2_version();
         available = sp::amesos2_klu2_available();

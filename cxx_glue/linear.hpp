@@ -1,9 +1,9 @@
 // Direct linear solvers behind one small interface on plain CSR arrays, so
 // the Newton code never depends on a backend and the backends never see the
-// Jacobian's Epetra objects (a later move to Tpetra is cheap). The Amesos
-// backends factor the Jacobian itself where CsrRows.matrix offers it (one
-// process), and otherwise build an Epetra matrix of their own from the
-// arrays (linear_amesos.cpp, epetra_rows.hpp).
+// Jacobian's Epetra objects (a later move to Tpetra is cheap). MUMPS, KLU,
+// SuperLU and SuperLU_DIST take the arrays through their own C interfaces;
+// KLU2 (Amesos2) and GMRES/ILU (AztecOO, Ifpack) build an Epetra matrix of
+// their own from them (epetra_rows.hpp).
 #ifndef SP_LINEAR_HPP
 #define SP_LINEAR_HPP
 
@@ -11,8 +11,6 @@
 
 #include <memory>
 #include <string>
-
-class Epetra_CrsMatrix;
 
 namespace sp {
 
@@ -36,11 +34,6 @@ struct CsrRows {
   const int *row_ptr = nullptr;  // n_rows + 1 offsets into col/val
   const int *col = nullptr;      // global column indices
   double *val = nullptr;         // overwritten by some backends' factor()
-  // The same rows as an Epetra matrix when the caller has one that is
-  // exactly them (the Jacobian on one process), else null: a backend
-  // that factors an Epetra matrix (Amesos) factors it instead of a copy.
-  // It stays alive and keeps its pattern while the layout does.
-  Epetra_CrsMatrix *matrix = nullptr;
 };
 
 // Every call is collective over the solver's communicator.
@@ -74,9 +67,6 @@ class DirectSolver {
   // call, and the caller may hand it storage it keeps using: Solver gives
   // the Jacobian's own arrays on one process).
   virtual bool overwrites_values() const { return false; }
-  // The caller's matrix (CsrRows.matrix) is about to go: let go of
-  // everything that refers to it (the next factor() starts anew).
-  virtual void forget_matrix() {}
 };
 
 // Serial SuperLU (dgstrf/dgstrs on the transposed CSC view of the CSR); one
@@ -94,9 +84,9 @@ std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, 
 // MUMPS through its own C interface (dmumps_c) on the rows as they are
 // distributed (linear_mumps.cpp).
 std::unique_ptr<DirectSolver> make_mumps(MPI_Comm comm);
-// Amesos (v1) on an Epetra copy of the rows: which = "Amesos_Klu". Throws
-// if Amesos was built without it.
-std::unique_ptr<DirectSolver> make_amesos(MPI_Comm comm, const std::string &which);
+// Serial KLU (SuiteSparse's libklu, linear_klu.cpp); one rank holding all
+// rows (make_gathered under MPI).
+std::unique_ptr<DirectSolver> make_klu();
 // KLU2 through Amesos2 on an Epetra copy of the rows; one process only
 // (throws on several: Debian 13.2's Amesos2 is wrong there, STACK.md).
 std::unique_ptr<DirectSolver> make_amesos2_klu2(MPI_Comm comm);
@@ -119,9 +109,7 @@ std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &op
 const char *superlu_version();
 const char *superlu_dist_version();
 const char *mumps_version();
-const char *amesos_version(const std::string &which);
-// Whether this Trilinos' Amesos was built with "Amesos_Klu".
-bool amesos_available(const std::string &which);
+const char *klu_version();
 const char *amesos2_klu2_version();
 bool amesos2_klu2_available();
 const char *krylov_version();

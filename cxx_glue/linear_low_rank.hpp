@@ -62,7 +62,6 @@ class LowRankSolver final : public DirectSolver {
   long iterations() const override { return sparse_->iterations(); }
   int symbolic_count() const override { return sparse_->symbolic_count(); }
   bool overwrites_values() const override { return sparse_->overwrites_values(); }
-  void forget_matrix() override { sparse_->forget_matrix(); }
 
  private:
   // Z = A^-1 U and K's LU from the block solve [B, U] (X gets A^-1 B).

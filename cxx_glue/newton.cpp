@@ -307,7 +307,9 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
                                   options.refine != 0);
       break;
     case SP_SOLVER_MUMPS: direct = make_mumps(comm); break;
-    case SP_SOLVER_KLU: direct = make_amesos(comm, "Amesos_Klu"); break;
+    case SP_SOLVER_KLU:  // serial KLU under MPI: gathered on rank 0, as SuperLU
+      direct = P == 1 ? make_klu() : make_gathered(comm, comm_.MyPID() == 0 ? make_klu() : nullptr);
+      break;
     case SP_SOLVER_KLU2:
       // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
       // ranks (STACK.md, docs/parallel.md): one process only.
@@ -408,7 +410,6 @@ void Solver::build_nox_solve() {
 
 void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout) {
   if (assembly_ && assembly_->same_layout(layout)) return;
-  linear_->forget_matrix();  // (a backend may hold the old Jacobian)
   assembly_.reset(new Assembly(comm_, mesh, layout));
   // The CSR rows handed to the direct solver: this rank's rows, global
   // column indices. The backends need each rank's rows contiguous and the
@@ -601,7 +602,6 @@ bool Solver::factor_jacobian(std::string &why) {
     A.row_ptr = offsets;
     A.col = cols;
     A.val = vals;
-    A.matrix = jacobian_matrix_.get();
   } else {
     for (int i = 0; i < n; ++i) {
       int len;

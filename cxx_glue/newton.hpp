@@ -93,8 +93,7 @@ class Solver {
   // The full (replicated) state from a distributed vector.
   void gather(const Epetra_Vector &x, std::vector<double> &full) const;
 
-  // The sparse part of J. Declared first, so destroyed last: a backend
-  // (MUMPS through Amesos) still reaches the matrix when it is destroyed.
+  // The sparse part of J (declared first, so destroyed last).
   Teuchos::RCP<Epetra_FECrsMatrix> jacobian_matrix_;
   // Why the current step's last linear solve failed (empty: none did).
   std::string linear_failure_;

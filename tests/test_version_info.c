@@ -54,14 +54,19 @@ int main(int argc, char **argv) {
     CHECK(value[0] != '\0', "info lists no linear solver '%s'", key);
     CHECK(strstr(value, "not in this build") == NULL, "%s: %s", key, value);
   }
-  /* klu2 is served by Amesos2, klu by Amesos (v1): not one library twice */
+  /* klu2 is served by Amesos2, klu by SuiteSparse's own KLU and mumps by
+   * MUMPS' own C interface (no Amesos v1: issue 31): not one library twice */
   const char *klu2 = NULL, *klu = NULL;
   CHECK(sp_solver_linear_backend(SP_SOLVER_KLU2, &klu2) == 1 && klu2 &&
             strstr(klu2, "Amesos2") != NULL,
         "klu2 is served by '%s', want Amesos2", klu2 ? klu2 : "(none)");
   CHECK(sp_solver_linear_backend(SP_SOLVER_KLU, &klu) == 1 && klu &&
-            strstr(klu, "Amesos") != NULL && strstr(klu, "Amesos2") == NULL,
-        "klu is served by '%s', want Amesos (v1)", klu ? klu : "(none)");
+            strstr(klu, "SuiteSparse") != NULL && strstr(klu, "Amesos") == NULL,
+        "klu is served by '%s', want SuiteSparse's KLU", klu ? klu : "(none)");
+  const char *mumps = NULL;
+  CHECK(sp_solver_linear_backend(SP_SOLVER_MUMPS, &mumps) == 1 && mumps &&
+            strstr(mumps, "MUMPS") != NULL && strstr(mumps, "Amesos") == NULL,
+        "mumps is served by '%s', want MUMPS' own interface", mumps ? mumps : "(none)");
   /* The BLAS line names a file that exists. */
   line_after(out, "BLAS: ", value, sizeof value);
   const char *from = strstr(value, "dgemm_ from ");

@@ -17,7 +17,7 @@ cd "$(dirname "$0")/.."
 # libptscotch-dev/libscotch-dev: Debian's Zoltan CMake config names their
 # .so files although nothing pulls them in (docs/building.md).
 PACKAGES=(cmake make g++ pkg-config
-  trilinos-all-dev trilinos-dev libsuperlu-dev libsuperlu-dist-dev libmumps-dev
+  trilinos-all-dev trilinos-dev libsuperlu-dev libsuperlu-dist-dev libmumps-dev libsuitesparse-dev
   libopenmpi-dev openmpi-bin libptscotch-dev libscotch-dev libopenblas-dev
   libcyaml-dev libcairo2-dev libhdf5-openmpi-dev)
 
