@@ -10,6 +10,14 @@
 extern "C" {
 #endif
 
+/** Room for a cell's name with its NUL: at most 31 characters, letters,
+ *  digits, '_', '.' and '-' (the scene's cells[i].name and lineage
+ *  table; "" for an unnamed cell). */
+#define SP_CELL_NAME_MAX 32
+
+/** A cell's name ("": none). */
+typedef char sp_cell_name[SP_CELL_NAME_MAX];
+
 /** Observables of one cell (MODEL.md, shape penalty, for the tensor). */
 typedef struct {
   double mass;      /**< m_k = int c_k dV (the conserved quantity) */

@@ -277,6 +277,8 @@ static int write_state(hid_t f, const sp_run *run) {
   bad |= put_array(f, "/cells/source_on", H5T_NATIVE_INT, run->cells.source_on, nc);
   bad |= put_array(f, "/cells/division_skipped", H5T_NATIVE_INT, run->cells.division_skipped, nc);
   bad |= put_array(f, "/cells/divided_now", H5T_NATIVE_UCHAR, run->cells.divided_now, nc);
+  bad |= put_array(f, "/cells/name", H5T_NATIVE_CHAR, run->cells.name, nc * SP_CELL_NAME_MAX);
+  bad |= put_array(f, "/cells/cut_normal", H5T_NATIVE_DOUBLE, run->cells.cut_normal, 3 * nc);
   bad |= put_members(f, "/controller", &run->dtc, controller_members, N_OF(controller_members));
   bad |= put_members(f, "/summary", run->mon.sum, summary_members, N_OF(summary_members));
   bad |= put_array(f, "/output/energy_t", H5T_NATIVE_DOUBLE, run->mon.energy_t,
@@ -726,6 +728,11 @@ static int read_registry(const sp_checkpoint ck, sp_registry *cells, int nc) {
   SP_CALL(get_array(ck, "/cells/source_on", H5T_NATIVE_INT, cells->source_on, nc));
   SP_CALL(get_array(ck, "/cells/division_skipped", H5T_NATIVE_INT, cells->division_skipped, nc));
   SP_CALL(get_array(ck, "/cells/divided_now", H5T_NATIVE_UCHAR, cells->divided_now, nc));
+  SP_CALL(get_array(ck, "/cells/name", H5T_NATIVE_CHAR, cells->name,
+                    (size_t)nc * SP_CELL_NAME_MAX));
+  for (int k = 0; k < nc; ++k) cells->name[k][SP_CELL_NAME_MAX - 1] = '\0';
+  SP_CALL(get_array(ck, "/cells/cut_normal", H5T_NATIVE_DOUBLE, cells->cut_normal,
+                    3 * (size_t)nc));
   return SP_OK;
 }
 

@@ -45,8 +45,9 @@
 extern "C" {
 #endif
 
-/** The checkpoint format this build writes and reads. */
-#define SP_CHECKPOINT_VERSION 1
+/** The checkpoint format this build writes and reads (2: the registry
+ *  holds the cells' names and cut normals, lineage.h). */
+#define SP_CHECKPOINT_VERSION 2
 
 /** An open checkpoint (sp_checkpoint_open). */
 typedef struct sp_checkpoint_s *sp_checkpoint;

@@ -181,7 +181,7 @@ static double child_mass(int n, const double *w, const double *c, const double *
 int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
                                const double *state, int parent,
                                const sp_cell_obs *parent_obs, int smooth, double width,
-                               double *offset) {
+                               double fraction, double *offset) {
   *offset = 0.0;
   SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
            "division: divisions are not yet on a 3D mesh (issue 29)");
@@ -216,17 +216,17 @@ int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
   lo -= margin;
   hi += margin;
   const double on_line = SP_DIVISION_ON_LINE_FRACTION * mesh->h;
-  /* M(lo) ~ total > total / 2 > M(hi) ~ 0: keep M(lo) >= half >= M(hi) */
-  const double half = 0.5 * total;
+  /* M(lo) ~ total > fraction total > M(hi) ~ 0: keep M(lo) >= target >= M(hi) */
+  const double target = fraction * total;
   double m_lo = child_mass(n, w, c, sd, lo, smooth, width, on_line);
   double m_hi = child_mass(n, w, c, sd, hi, smooth, width, on_line);
-  for (int it = 0; it < SP_DIVISION_BALANCE_STEPS && m_lo >= half && m_hi <= half; ++it) {
+  for (int it = 0; it < SP_DIVISION_BALANCE_STEPS && m_lo >= target && m_hi <= target; ++it) {
     const double mid = 0.5 * (lo + hi);
     const double m_mid = child_mass(n, w, c, sd, mid, smooth, width, on_line);
-    if (m_mid >= half) { lo = mid; m_lo = m_mid; }
+    if (m_mid >= target) { lo = mid; m_lo = m_mid; }
     else { hi = mid; m_hi = m_mid; }
   }
-  *offset = fabs(m_lo - half) <= fabs(m_hi - half) ? lo : hi;
+  *offset = fabs(m_lo - target) <= fabs(m_hi - target) ? lo : hi;
   free(buffer);
   return SP_OK;
 }

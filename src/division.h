@@ -60,6 +60,9 @@ typedef struct {
   double angle;          /**< of the division axis, in (-pi/2, pi/2] */
   double parent_mass;    /**< before the cut */
   double mass_a, mass_b; /**< the daughters' right after it */
+  sp_cell_name parent_name, name_a, name_b; /**< named cells (lineage.h) */
+  double fraction;       /**< the lineage table's share of the first daughter
+                              (NaN: no entry) */
 } sp_division_record;
 
 /** Division criterion (MODEL.md "Division"), chosen per scene. */
@@ -234,8 +237,10 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
                       int child);
 
 /**
- * @brief The shift of the division line along its normal n that splits the
- *        parent's mass into equal halves (`division.line: equal_mass`).
+ * @brief The shift of the division line along its normal n that gives the
+ *        child the share @p fraction of the parent's mass (0.5: equal
+ *        halves, `division.line: equal_mass`; the lineage table's
+ *        asymmetric divisions, lineage.h).
  *
  * The line through the centre of mass halves only a symmetric cell: a
  * packed, egg-shaped parent is split 46/54 by it (docs/paper-runs.md, run
@@ -244,9 +249,12 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
  * where w_i = int phi_i over the parent's elements (all four nodes in its
  * support: the rule of sp_cells_observe, so M(s) is exactly the mass the
  * observables will report), decreases with s; bisection finds M(s) =
- * M_parent / 2. The smoothed cut's M is continuous, so the halves agree to
- * round-off; the sharp cut's M jumps by one node's share, and the offset
- * returned is the side of the last jump closer to the half.
+ * fraction M_parent. The smoothed cut's M is continuous, so the share is
+ * met to round-off (tests/test_lineage.c: 1e-9 relative); the sharp cut's
+ * M jumps by one node's share w_i c_i (half of it at a time: a node on the
+ * line is shared 1/2), and the offset returned is the side of the last jump
+ * closer to the target: the share is met to half a jump, at most
+ * max_i w_i c_i / (2 M_parent).
  * The axis (direction) is unchanged: the cell is still cut across its
  * length; only the line's position moves (by much less than the cell's
  * radius for any parent that is nearly convex).
@@ -257,7 +265,7 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
 int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
                                const double *state, int parent,
                                const sp_cell_obs *parent_obs, int smooth, double width,
-                               double *offset);
+                               double fraction, double *offset);
 
 /**
  * @brief Birth records of both daughters after a split at time @p t: birth

@@ -10,6 +10,7 @@
 #include "division.h"
 #include "error.h"
 #include "layout.h"
+#include "lineage.h"
 #include "resize.h"
 #include "run_energy.h"
 #include "source.h"
@@ -25,12 +26,15 @@ double sp_events_next(const sp_run *run, double t) {
     const double k = floor((t + slack) / every) + 1;
     event = fmin(event, k * every);
   }
-  if (run->opt.time.adaptive && run->opt.division.criterion == SP_DIVIDE_BY_AGE &&
-      run->layout->n_cells < run->n_max) {
-    for (int k = 0; k < run->layout->n_cells; ++k) {
-      const double due = run->cells.birth[k].birth_time + run->opt.division.t_div;
-      if (due > t + slack) event = fmin(event, due);
-    }
+  if (!run->opt.time.adaptive) return event;
+  const int by_age = run->opt.division.criterion == SP_DIVIDE_BY_AGE &&
+                     run->layout->n_cells < run->n_max;
+  for (int k = 0; k < run->layout->n_cells; ++k) {
+    const sp_lineage_entry *e = sp_lineage_find(&run->lineage, run->cells.name[k]);
+    if (!e && !by_age) continue;
+    const double due = e ? sp_lineage_due_time(e, &run->cells.birth[k])
+                         : run->cells.birth[k].birth_time + run->opt.division.t_div;
+    if (due > t + slack) event = fmin(event, due);
   }
   return event;
 }
@@ -53,21 +57,25 @@ int sp_events_landing(sp_run *run, double t, double dt, int *observed, double *t
   *theta = 1.0;
   const sp_registry *cells = &run->cells;
   const int n_cells = run->layout->n_cells;
-  if (!(run->opt.time.adaptive && run->opt.division.criterion == SP_DIVIDE_BY_MASS &&
-        n_cells < run->n_max))
-    return SP_OK;
+  const int by_mass = run->opt.division.criterion == SP_DIVIDE_BY_MASS && n_cells < run->n_max;
+  int lineage_mass = 0;
+  for (int i = 0; i < run->lineage.n; ++i)
+    lineage_mass |= run->lineage.entry[i].when == SP_LINEAGE_MASS;
+  if (!(run->opt.time.adaptive && (by_mass || lineage_mass))) return SP_OK;
   /* observed here, kept if the step stands */
   SP_CALL(sp_run_observe(run, cells->obs_new));
   *observed = 1;
   for (int k = 0; k < n_cells; ++k) {
+    const sp_lineage_entry *e = sp_lineage_find(&run->lineage, cells->name[k]);
+    if (e ? e->when != SP_LINEAGE_MASS : !by_mass) continue;
+    const sp_division_params p =
+        e ? sp_lineage_params(e, &cells->birth[k], run->division.tolerance) : run->division;
     const double m_old = cells->obs[k].mass_core, m_new = cells->obs_new[k].mass_core;
-    if (!sp_division_due(&run->division, &cells->birth[k], t, t + dt, m_old, m_new))
-      continue;
-    const double f = sp_division_crossing_fraction(&run->division, &cells->birth[k], t,
-                                                   t + dt, m_old, m_new);
+    if (!sp_division_due(&p, &cells->birth[k], t, t + dt, m_old, m_new)) continue;
+    const double f = sp_division_crossing_fraction(&p, &cells->birth[k], t, t + dt, m_old, m_new);
     /* overshot: past the threshold by more than the tolerance */
-    const double over = m_new - sp_division_threshold(&run->division, &cells->birth[k]) *
-                                    (1 + SP_MASS_LANDING_TOLERANCE);
+    const double over =
+        m_new - sp_division_threshold(&p, &cells->birth[k]) * (1 + SP_MASS_LANDING_TOLERANCE);
     if (f > 0 && f < 1 && over > 0) *theta = fmin(*theta, f);
   }
   return SP_OK;
@@ -108,25 +116,30 @@ static int layout_with_child(sp_run *run, int parent, sp_layout **out) {
 
 /** The split state of a division of @p parent on @p new_layout, the child
  *  being its last cell (the division line through the centre, or moved to
- *  halve the mass: division.line). */
+ *  halve the mass: division.line; to give the first daughter, the parent's
+ *  slot, its share of a lineage entry @p e). */
 static int split_state(sp_run *run, int parent, const sp_cell_obs *parent_obs,
-                       const sp_layout *new_layout, double *new_state) {
+                       const sp_lineage_entry *e, const sp_layout *new_layout,
+                       double *new_state) {
   const sp_run_division *dv = &run->opt.division;
   double offset = 0.0;
-  if (dv->equal_mass_line)
+  if (e || dv->equal_mass_line)
     SP_CALL(sp_division_balance_offset(run->mesh, run->layout, run->state, parent, parent_obs,
-                                       dv->smooth_cut, dv->interface_width, &offset));
+                                       dv->smooth_cut, dv->interface_width,
+                                       e ? 1.0 - e->fraction : 0.5, &offset));
   return sp_division_split(run->mesh, run->layout, run->state, parent, parent_obs,
                            dv->smooth_cut, dv->interface_width, offset, new_layout, new_state,
                            new_layout->n_cells - 1);
 }
 
 /**
- * Divide cell @p parent (paper algorithm 1): a new layout with one more
- * cell, the split state on it, the registry entries of both daughters, a
- * row of divisions.csv.
+ * Divide cell @p parent (paper algorithm 1; by its lineage entry @p e, or
+ * the scene's rules for NULL): a new layout with one more cell, the split
+ * state on it, the registry entries of both daughters, a row of
+ * divisions.csv.
  */
-static int divide_cell(sp_run *run, int parent, sp_division_record *record) {
+static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
+                       sp_division_record *record) {
   const int n = run->layout->n_cells, child = n;
   sp_layout *new_layout = NULL;
   SP_CALL(layout_with_child(run, parent, &new_layout));
@@ -135,8 +148,13 @@ static int divide_cell(sp_run *run, int parent, sp_division_record *record) {
     sp_layout_destroy(&new_layout);
     return sp_error_set(SP_ERR_MEMORY, "out of memory dividing cell %d", parent + 1);
   }
-  const sp_cell_obs parent_obs = run->cells.obs[parent];
-  const int rc = split_state(run, parent, &parent_obs, new_layout, new_state);
+  /* the parent's observables, with the cut's normal of its entry */
+  sp_cell_obs parent_obs = run->cells.obs[parent];
+  double long_axis[3], normal[3];
+  sp_lineage_obs_normal(&parent_obs, long_axis);
+  sp_lineage_normal(e, run->mesh->dim, long_axis, run->cells.cut_normal[parent], normal);
+  if (e) sp_lineage_set_obs_normal(&parent_obs, normal);
+  const int rc = split_state(run, parent, &parent_obs, e, new_layout, new_state);
   if (rc != SP_OK) {
     free(new_state);
     sp_layout_destroy(&new_layout);
@@ -149,6 +167,11 @@ static int divide_cell(sp_run *run, int parent, sp_division_record *record) {
   SP_CALL(sp_run_observe(run, cells->obs));
   sp_cells_core_view(cells->obs, n + 1, cells->obs_new); /* (scratch) */
   sp_division_record_births(run->t, cells->obs_new, parent, child, cells->birth);
+  sp_cell_name parent_name;
+  memcpy(parent_name, cells->name[parent], sizeof parent_name);
+  sp_lineage_daughter_names(e, parent_name, cells->name[parent], cells->name[child]);
+  memcpy(cells->cut_normal[parent], normal, sizeof normal);
+  memcpy(cells->cut_normal[child], normal, sizeof normal);
   double px, py, dx, dy;
   sp_division_axis(&parent_obs, &px, &py, &dx, &dy);
   double angle = atan2(dy, dx);
@@ -157,22 +180,31 @@ static int divide_cell(sp_run *run, int parent, sp_division_record *record) {
   *record = (sp_division_record){.parent = parent, .child = child, .angle = angle,
                                  .parent_mass = parent_obs.mass,
                                  .mass_a = cells->obs[parent].mass,
-                                 .mass_b = cells->obs[child].mass};
+                                 .mass_b = cells->obs[child].mass,
+                                 .fraction = e ? e->fraction : NAN};
+  memcpy(record->parent_name, parent_name, sizeof parent_name);
+  memcpy(record->name_a, cells->name[parent], sizeof record->name_a);
+  memcpy(record->name_b, cells->name[child], sizeof record->name_b);
   return SP_OK;
 }
 
 /** After the step from @p t_old: divide every cell whose criterion was
- *  crossed (daughters born now wait a step). */
+ *  crossed, its lineage entry's or the scene's (daughters born now wait a
+ *  step). N_max limits the scene's divisions only: the table is a schedule. */
 static int divide_due_cells(sp_run *run, double t_old, int *n_divided) {
   *n_divided = 0;
-  if (run->opt.division.criterion == SP_DIVIDE_NONE) return SP_OK;
+  const int by_rule = run->opt.division.criterion != SP_DIVIDE_NONE;
+  if (!by_rule && run->lineage.n == 0) return SP_OK;
   const int n = run->layout->n_cells;
   for (int k = 0; k < n; ++k) {
     sp_registry *cells = &run->cells;
-    if (!sp_division_due(&run->division, &cells->birth[k], t_old, run->t,
-                         cells->core_mass_old[k], cells->obs[k].mass_core))
+    const sp_lineage_entry *e = sp_lineage_find(&run->lineage, cells->name[k]);
+    if (e ? !sp_lineage_due(e, &cells->birth[k], run->t, cells->obs[k].mass_core,
+                            run->division.tolerance)
+          : !by_rule || !sp_division_due(&run->division, &cells->birth[k], t_old, run->t,
+                                         cells->core_mass_old[k], cells->obs[k].mass_core))
       continue;
-    if (run->layout->n_cells >= run->n_max) {
+    if (!e && run->layout->n_cells >= run->n_max) {
       if (!cells->division_skipped[k] && run->rank == 0)
         fprintf(stderr, "softpack: cell %d is due to divide at t = %.6g but N_max = %d cells "
                         "exist already; it does not divide\n", k + 1, run->t, run->n_max);
@@ -180,7 +212,7 @@ static int divide_due_cells(sp_run *run, double t_old, int *n_divided) {
       continue;
     }
     sp_division_record record; /* (the registry grows in the division) */
-    SP_CALL(divide_cell(run, k, &record));
+    SP_CALL(divide_cell(run, k, e, &record));
     run->cells.divisions[*n_divided] = record;
     ++*n_divided;
   }

@@ -1,10 +1,12 @@
 /**
  * @file events.h
  * @brief The run's events in one place: the times a step must land on
- *        (t_end, output times, age divisions), the mass criterion's landing
- *        rule inside an attempt, and what happens after an accepted step:
- *        divisions (algorithm 1), the local supports' change, the
- *        controller's restart after a division, the source switch.
+ *        (t_end, output times, age divisions and the lineage table's age
+ *        and time divisions), the mass criterion's landing rule inside an
+ *        attempt, and what happens after an accepted step: divisions
+ *        (algorithm 1; a named cell by its lineage entry, lineage.h), the
+ *        local supports' change, the controller's restart after a
+ *        division, the source switch.
  */
 #ifndef SP_EVENTS_H
 #define SP_EVENTS_H
@@ -37,7 +39,7 @@ typedef struct {
 
 /** @brief The next time a step must land on after @p t: t_end, the next
  *         output time (output.interval), and with adaptive control the
- *         next age division. */
+ *         next age division (or a lineage entry's age or time). */
 double sp_events_next(const sp_run *run, double t);
 
 /** @brief The first dt from the run's state (a run's start, after a

@@ -58,7 +58,8 @@ static int record_energy(sp_run *run, double dt, int its, const sp_step_costs *c
   if (run->rank != 0) return SP_OK;
   SP_CALL(sp_output_energy(mon->output, run->step, run->t, dt, its, n_cells, &parts, shape,
                            costs));
-  return sp_output_cells(mon->output, run->step, run->t, n_cells, run->cells.obs);
+  return sp_output_cells(mon->output, run->step, run->t, n_cells, run->cells.obs,
+                         run->cells.name);
 }
 
 /** The fields of the state: a piece per rank and the .pvtu by rank 0 under
@@ -104,9 +105,10 @@ int sp_monitor_open(sp_run *run) {
   if (run->rank == 0) {
     if (run->restarted) { /* the logs cut back to the checkpoint's step */
       sp_checkpoint_remove_after(mon->out_dir, run->step);
-      rc = sp_output_resume(mon->out_dir, run->step, mon->n_fields, mon->fields, &mon->output);
+      rc = sp_output_resume(mon->out_dir, run->step, run->lineage.named, mon->n_fields,
+                            mon->fields, &mon->output);
     } else {
-      rc = sp_output_open_dim(mon->out_dir, run->mesh->dim, &mon->output);
+      rc = sp_output_open_dim(mon->out_dir, run->mesh->dim, run->lineage.named, &mon->output);
     }
   }
   free(mon->fields);
@@ -206,8 +208,7 @@ static int record_divisions(sp_run *run, const sp_step_events *ev) {
     const sp_division_record *d = &ev->divisions[i];
     SP_CALL(append(&mon->division_t, &mon->n_divisions, run->t));
     if (run->rank == 0)
-      SP_CALL(sp_output_division(mon->output, run->t, run->step, d->parent, d->child, d->angle,
-                                 d->parent_mass, d->mass_a, d->mass_b));
+      SP_CALL(sp_output_division(mon->output, run->t, run->step, d));
   }
   return SP_OK;
 }

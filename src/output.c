@@ -19,6 +19,7 @@
 #include "output.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -34,6 +35,8 @@ struct sp_output_s {
   char *energy_path, *cells_path, *divisions_path;
   FILE *energy, *cells, *divisions;
   int dim; /**< the mesh's: cells.csv has z on a 3D one */
+  int named; /**< the scene names its cells: cells.csv and divisions.csv
+                  end with name columns */
   int n_fields, cap_fields;
   sp_output_field *fields; /**< each fields file written, in write order */
 };
@@ -272,16 +275,22 @@ static const struct {
  *  the membrane; no moments yet (issue 29). */
 static const char sp_cells_header_3d[] = "step,t,cell,mass,xc,yc,zc,core_mass,volume";
 
+/** What named cells add to cells.csv and divisions.csv (lineage.h): the
+ *  names and the lineage table's share of the first daughter. */
+static const char sp_cells_names[] = ",name";
+static const char sp_divisions_names[] = ",parent_name,first_name,second_name,fraction";
+
 /** Open @p dir's logs for a mesh of dimension @p dim: new ones
  *  (@p resume_step < 0), or the existing ones cut back to the rows of steps
  *  <= @p resume_step and appended to. */
-static int output_open(const char *dir, int dim, int resume_step, sp_output *out) {
+static int output_open(const char *dir, int dim, int named, int resume_step, sp_output *out) {
   *out = NULL;
   SP_CALL(sp_mkdir_p(dir));
   struct sp_output_s *o;
   SP_ALLOC(o, 1);
   o->dir = sp_strfmt("%s", dir);
   o->dim = dim;
+  o->named = named;
   o->energy_path = sp_strfmt("%s/%s", dir, sp_logs[0].name);
   o->cells_path = sp_strfmt("%s/%s", dir, sp_logs[1].name);
   o->divisions_path = sp_strfmt("%s/%s", dir, sp_logs[2].name);
@@ -295,7 +304,13 @@ static int output_open(const char *dir, int dim, int resume_step, sp_output *out
     int exists = 0;
     if (resume_step >= 0) rc = sp_log_cut(paths[i], sp_logs[i].step_column, resume_step, &exists);
     const char *header = i == 1 && dim == 3 ? sp_cells_header_3d : sp_logs[i].header;
-    if (rc == SP_OK) rc = sp_log_open(paths[i], exists ? NULL : header, files[i]);
+    char *named_header =
+        sp_strfmt("%s%s", header, !named ? "" : i == 1 ? sp_cells_names
+                                             : i == 2 ? sp_divisions_names : "");
+    if (!named_header && rc == SP_OK)
+      rc = sp_error_set(SP_ERR_MEMORY, "out of memory for the header of '%s'", paths[i]);
+    if (rc == SP_OK) rc = sp_log_open(paths[i], exists ? NULL : named_header, files[i]);
+    free(named_header);
   }
   if (rc != SP_OK) {
     sp_output_close(&o); /* keeps the first error's message */
@@ -305,11 +320,11 @@ static int output_open(const char *dir, int dim, int resume_step, sp_output *out
   return SP_OK;
 }
 
-int sp_output_open(const char *dir, sp_output *out) { return output_open(dir, 2, -1, out); }
+int sp_output_open(const char *dir, sp_output *out) { return output_open(dir, 2, 0, -1, out); }
 
-int sp_output_open_dim(const char *dir, int dim, sp_output *out) {
+int sp_output_open_dim(const char *dir, int dim, int named, sp_output *out) {
   SP_CHECK(dim == 2 || dim == 3, SP_ERR_INTERNAL, "output: dimension %d", dim);
-  return output_open(dir, dim, -1, out);
+  return output_open(dir, dim, named, -1, out);
 }
 
 int sp_output_energy(sp_output out, int step, double t, double dt,
@@ -333,28 +348,33 @@ int sp_output_energy(sp_output out, int step, double t, double dt,
 }
 
 int sp_output_cells(sp_output out, int step, double t, int n_cells,
-                    const sp_cell_obs *obs) {
+                    const sp_cell_obs *obs, const sp_cell_name *names) {
   int n = 0;
-  if (out->dim == 3) {
-    for (int k = 0; k < n_cells && n >= 0; ++k)
-      n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", step, t,
+  /* a named scene's rows end with the name */
+  for (int k = 0; k < n_cells && n >= 0; ++k) {
+    if (out->dim == 3)
+      n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", step, t,
                   k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].zc, obs[k].mass_core,
                   obs[k].area);
-    return sp_log_done(out->cells, out->cells_path, n);
+    else
+      n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                  step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].I1,
+                  obs[k].I2, obs[k].angle, obs[k].mass_core, obs[k].area);
+    if (n >= 0 && out->named) n = fprintf(out->cells, ",%s", names ? names[k] : "");
+    if (n >= 0) n = fprintf(out->cells, "\n");
   }
-  for (int k = 0; k < n_cells && n >= 0; ++k)
-    n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].I1,
-                obs[k].I2, obs[k].angle, obs[k].mass_core, obs[k].area);
   return sp_log_done(out->cells, out->cells_path, n);
 }
 
-int sp_output_division(sp_output out, double t, int step, int parent,
-                       int child, double axis_angle, double mass_before,
-                       double parent_mass_after, double child_mass_after) {
-  int n = fprintf(out->divisions, "%.17g,%d,%d,%d,%.17g,%.17g,%.17g,%.17g\n",
-                  t, step, parent + 1, child + 1, axis_angle, mass_before,
-                  parent_mass_after, child_mass_after);
+int sp_output_division(sp_output out, double t, int step, const sp_division_record *d) {
+  int n = fprintf(out->divisions, "%.17g,%d,%d,%d,%.17g,%.17g,%.17g,%.17g",
+                  t, step, d->parent + 1, d->child + 1, d->angle, d->parent_mass,
+                  d->mass_a, d->mass_b);
+  if (n >= 0 && out->named) {
+    n = fprintf(out->divisions, ",%s,%s,%s,", d->parent_name, d->name_a, d->name_b);
+    if (n >= 0 && !isnan(d->fraction)) n = fprintf(out->divisions, "%.17g", d->fraction);
+  }
+  if (n >= 0) n = fprintf(out->divisions, "\n");
   return sp_log_done(out->divisions, out->divisions_path, n);
 }
 
@@ -754,9 +774,9 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
   return sp_pvd_write(out);
 }
 
-int sp_output_resume(const char *dir, int step, int n_fields, const sp_output_field *fields,
-                     sp_output *out) {
-  SP_CALL(output_open(dir, 2, step, out)); /* (checkpoints are 2D) */
+int sp_output_resume(const char *dir, int step, int named, int n_fields,
+                     const sp_output_field *fields, sp_output *out) {
+  SP_CALL(output_open(dir, 2, named, step, out)); /* (checkpoints are 2D) */
   for (int i = 0; i < n_fields; ++i)
     if (fields[i].step <= step) {
       int rc = sp_fields_record(*out, fields[i].step, fields[i].t, fields[i].pvtu);

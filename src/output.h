@@ -8,6 +8,7 @@
 #define SP_OUTPUT_H
 
 #include "cells.h"
+#include "division.h"
 #include "layout.h"
 #include "mesh.h"
 #include "softpack_solver.h"
@@ -23,8 +24,11 @@ typedef struct sp_output_s *sp_output;
 int sp_output_open(const char *dir, sp_output *out);
 
 /** @brief sp_output_open for a mesh of dimension @p dim (2 or 3): on a 3D
- *         mesh cells.csv is step,t,cell,mass,xc,yc,zc,core_mass,volume. */
-int sp_output_open_dim(const char *dir, int dim, sp_output *out);
+ *         mesh cells.csv is step,t,cell,mass,xc,yc,zc,core_mass,volume;
+ *         @p named (the scene names its cells): cells.csv ends with a name
+ *         column, divisions.csv with parent_name,first_name,second_name,
+ *         fraction. */
+int sp_output_open_dim(const char *dir, int dim, int named, sp_output *out);
 
 /** One fields file of fields.pvd: fields_<step>.vtu, or .pvtu of pieces. */
 typedef struct {
@@ -39,8 +43,8 @@ typedef struct {
  *        last line) and appended to; fields.pvd lists @p fields up to
  *        @p step. Logs that do not exist are started with their headers.
  */
-int sp_output_resume(const char *dir, int step, int n_fields, const sp_output_field *fields,
-                     sp_output *out);
+int sp_output_resume(const char *dir, int step, int named, int n_fields,
+                     const sp_output_field *fields, sp_output *out);
 
 /** What sp_vtu_read finds in a softpack .vtu: the points (x, y) and every
  *  cell's c and mu at them (cell-major: c[k n_points + i]). */
@@ -92,10 +96,11 @@ int sp_output_energy(sp_output out, int step, double t, double dt,
                      double shape, const sp_step_costs *seconds);
 
 /** @brief Append one row per cell to cells.csv:
- *  step,t,cell,mass,xc,yc,I1,I2,angle,core_mass (cells numbered from 1;
- *  core_mass counts c only where c >= the observables' threshold) */
+ *  step,t,cell,mass,xc,yc,I1,I2,angle,core_mass,area (cells numbered from 1;
+ *  core_mass counts c only where c >= the observables' threshold), and
+ *  with named cells (sp_output_open_dim) its name from @p names (NULL: "") */
 int sp_output_cells(sp_output out, int step, double t, int n_cells,
-                    const sp_cell_obs *obs);
+                    const sp_cell_obs *obs, const sp_cell_name *names);
 
 /**
  * @brief Write fields_<step>.vtu (unstructured grid of quads; point arrays
@@ -127,10 +132,12 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
 
 /** @brief Append one row to divisions.csv: t,step,parent,child,axis_angle,
  *         parent_mass_before,parent_mass_after,child_mass_after (cells
- *         numbered from 1; the angle is the division line's, from x). */
-int sp_output_division(sp_output out, double t, int step, int parent,
-                       int child, double axis_angle, double mass_before,
-                       double parent_mass_after, double child_mass_after);
+ *         numbered from 1; the angle is the division line's, from x; the
+ *         first daughter keeps the parent's number), and with named cells
+ *         parent_name,first_name,second_name,fraction (the lineage table's
+ *         share of the first daughter; empty for a division by the scene's
+ *         division: rules). */
+int sp_output_division(sp_output out, double t, int step, const sp_division_record *d);
 
 /** @brief The directory path (borrowed). */
 const char *sp_output_dir(sp_output out);

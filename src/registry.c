@@ -27,6 +27,8 @@ int sp_registry_resize(sp_registry *reg, int n) {
   SP_CALL(resize_array((void **)&reg->core_mass, sizeof *reg->core_mass, n_old, n));
   SP_CALL(resize_array((void **)&reg->divisions, sizeof *reg->divisions, n_old, n));
   SP_CALL(resize_array((void **)&reg->shape, sizeof *reg->shape, n_old, n));
+  SP_CALL(resize_array((void **)&reg->name, sizeof *reg->name, n_old, n));
+  SP_CALL(resize_array((void **)&reg->cut_normal, sizeof *reg->cut_normal, n_old, n));
   reg->n = n;
   return SP_OK;
 }
@@ -42,5 +44,7 @@ void sp_registry_free(sp_registry *reg) {
   free(reg->core_mass);
   free(reg->shape);
   free(reg->divisions);
+  free(reg->name);
+  free(reg->cut_normal);
   *reg = (sp_registry){0};
 }

@@ -4,7 +4,8 @@
  *        field, in one object with one lifecycle (sized by the layout
  *        change, resize.h, at set-up, division and checkpoint restore).
  *        Per cell: its observables, its birth (time, mass, reference
- *        moments, generation), its source switch, whether a due division
+ *        moments, generation), its name and the normal of the cut that
+ *        made it, its source switch, whether a due division
  *        was skipped, whether it divided this step; and the per-cell
  *        scratch of a step (the observables of the step's end, the core
  *        masses before it, the shape coefficients), so a step allocates
@@ -29,6 +30,11 @@ typedef struct {
   int *division_skipped;  /**< due but N_max reached: reported once */
   unsigned char *divided_now; /**< parent or daughter of a division this
                                    step: its support may shrink */
+  sp_cell_name *name;     /**< its name ("": none; the scene's cells[i].name,
+                               the lineage table's daughters: lineage.h) */
+  double (*cut_normal)[3]; /**< the unit normal of the cut that made it
+                                (0 for an initial cell): the axis rule
+                                perpendicular turns it */
   /* a step's scratch (contents undefined between steps) */
   sp_cell_obs *obs_new;   /**< the observables of the step's end */
   double *core_mass_old;  /**< the core masses before the step */

@@ -55,8 +55,10 @@ static int renumber_rcb(sp_run *run) {
 }
 
 /** The registry of a new run from the fields: every cell born at t = 0
- *  with its core mass and moments now, its source on; N_max. */
-static int new_registry(sp_run *run, const sp_scene_division *dv) {
+ *  with its core mass and moments now, its source on, its scene's name (the
+ *  cells of a file have none); N_max. */
+static int new_registry(sp_run *run, const sp_scene *scene) {
+  const sp_scene_division *dv = &scene->division;
   sp_registry *cells = &run->cells;
   const int n = run->layout->n_cells;
   SP_CALL(sp_run_observe(run, cells->obs));
@@ -66,6 +68,9 @@ static int new_registry(sp_run *run, const sp_scene_division *dv) {
     cells->source_on[k] = 1;
     cells->division_skipped[k] = 0;
     cells->divided_now[k] = 0;
+    memset(cells->cut_normal[k], 0, sizeof cells->cut_normal[k]);
+    memset(cells->name[k], 0, sizeof cells->name[k]);
+    if (n == scene->n_cells) memcpy(cells->name[k], scene->cells[k].name, sizeof cells->name[k]);
   }
   run->n_max = dv->max_cells > 0 ? dv->max_cells
                : sp_division_max_cells(sp_mesh_region_area(run->mesh, SP_REGION_OMEGA),
@@ -78,10 +83,12 @@ static int new_registry(sp_run *run, const sp_scene_division *dv) {
 static int maybe_local_supports(sp_run *run, const sp_scene *scene, int n_cells) {
   const sp_scene_layout *ly = &scene->layout;
   const int can_divide = scene->division.criterion != SP_DIVIDE_NONE;
+  /* (each lineage entry makes one cell more) */
   const int local =
       ly->support == SP_SUPPORT_LOCAL ||
       (ly->support == SP_SUPPORT_AUTO &&
-       (n_cells > SP_AUTO_LOCAL_CELLS || (can_divide && run->n_max > SP_AUTO_LOCAL_CELLS)));
+       (n_cells + scene->n_lineage > SP_AUTO_LOCAL_CELLS ||
+        (can_divide && run->n_max > SP_AUTO_LOCAL_CELLS)));
   if (!local) return SP_OK;
   const double d = sp_scene_interface_width(scene);
   sp_support_params sp = {.margin = ly->margin * d, .core_threshold = ly->core_threshold,
@@ -115,7 +122,7 @@ static int from_checkpoint(sp_run *run, const sp_scene *scene, const sp_run_star
     SP_CALL(sp_checkpoint_restore_carry(start->checkpoint, run));
     return sp_run_observe(run, run->cells.obs);
   }
-  SP_CALL(new_registry(run, &scene->division)); /* observes too */
+  SP_CALL(new_registry(run, scene)); /* observes too */
   *reference_mass = run->cells.birth[0].birth_mass;
   return SP_OK;
 }
@@ -164,7 +171,7 @@ static int initial_run(sp_run *run, const sp_scene *scene, MPI_Comm comm,
   SP_CALL(sp_registry_resize(&run->cells, *n));
   if (!placeholder) SP_CALL(sp_initial_state(scene, run->mesh, run->layout, run->state));
   SP_CALL(renumber_rcb(run));
-  if (!placeholder) return new_registry(run, &scene->division);
+  if (!placeholder) return new_registry(run, scene);
   /* what decides on local supports: the checkpoint's cells */
   sp_checkpoint_cells(start->checkpoint, n, &run->n_max);
   return SP_OK;
@@ -174,6 +181,7 @@ static int initial_run(sp_run *run, const sp_scene *scene, MPI_Comm comm,
  *  agreed yet. */
 static int setup(sp_run *run, const sp_scene *scene, MPI_Comm comm, const sp_run_start *start) {
   int n;
+  SP_CALL(sp_lineage_from_scene(scene, &run->lineage));
   SP_CALL(initial_run(run, scene, comm, start, &n));
   /* use_initial_mass: the first initial cell's birth mass (the same for a
    * run continued from a checkpoint, whose scene has the same cells) */
@@ -220,5 +228,6 @@ void sp_run_free(sp_run *run) {
   run->buf = (sp_step_buffers){0};
   sp_history_free(&run->hist);
   sp_registry_free(&run->cells);
+  sp_lineage_free(&run->lineage);
   sp_support_destroy(&run->support);
 }

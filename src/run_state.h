@@ -27,6 +27,7 @@
 #include "division.h"
 #include "dt_control.h"
 #include "layout.h"
+#include "lineage.h"
 #include "mesh.h"
 #include "output.h"
 #include "registry.h"
@@ -98,6 +99,7 @@ typedef struct {
   sp_registry cells;    /**< the cell registry */
   int n_max;            /**< N_max */
   sp_division_params division; /**< the division criterion */
+  sp_lineage lineage;   /**< the lineage table (lineage.h; from the scene) */
   int restarted;        /**< 1: continued from a checkpoint (not as initial) */
   /* scratch of a step */
   sp_step_buffers buf;

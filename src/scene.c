@@ -67,12 +67,47 @@ typedef enum {
   SP_SEC_SHAPE,
   SP_SEC_INITIAL,
   SP_SEC_CELLS, /**< a sequence of cell mappings, not a mapping of scalars */
+  SP_SEC_LINEAGE, /**< a sequence of lineage entries, like cells */
   SP_N_SECTIONS
 } sp_section;
 
+/** The sections before SP_SEC_CELLS are mappings of scalars, the rest
+ *  sequences of mappings (one record each: sp_sequences[]). */
+#define SP_N_MAPPINGS SP_SEC_CELLS
+#define SP_N_SEQUENCES (SP_N_SECTIONS - SP_N_MAPPINGS)
+
 static const char *const sp_section_names[SP_N_SECTIONS] = {
     "mesh", "model", "time", "noise", "solver", "output", "division", "source",
-    "layout", "shape", "initial", "cells"};
+    "layout", "shape", "initial", "cells", "lineage"};
+
+/** A sequence section: where its records and their count live in sp_scene,
+ *  a record's size, and what one entry is called in messages. */
+typedef struct {
+  size_t records, count, size;
+  const char *entry;
+} sp_sequence;
+
+static const sp_sequence sp_sequences[SP_N_SEQUENCES] = {
+    {offsetof(sp_scene, cells), offsetof(sp_scene, n_cells), sizeof(sp_scene_cell), "a cell"},
+    {offsetof(sp_scene, lineage), offsetof(sp_scene, n_lineage), sizeof(sp_scene_lineage),
+     "a lineage entry"}};
+
+static int is_sequence(sp_section section) { return section >= SP_N_MAPPINGS; }
+
+/** The sequence of a sequence section. */
+static const sp_sequence *sequence_of(sp_section section) {
+  return &sp_sequences[section - SP_N_MAPPINGS];
+}
+
+/** Record @p i of a sequence section of @p scene. */
+static void *sequence_record(const sp_scene *scene, sp_section section, int i) {
+  const sp_sequence *q = sequence_of(section);
+  return *(char *const *)((const char *)scene + q->records) + (size_t)i * q->size;
+}
+
+static int sequence_count(const sp_scene *scene, sp_section section) {
+  return *(const int *)((const char *)scene + sequence_of(section)->count);
+}
 
 /** Scalar type of a key as the user sees it. */
 typedef enum {
@@ -81,11 +116,12 @@ typedef enum {
   SP_KEY_UINT,  /**< unsigned */
   SP_KEY_BOOL,  /**< int 0/1, written true/false (yes/no, on/off) */
   SP_KEY_ENUM,  /**< int, written as one of a list of words */
-  SP_KEY_PATH   /**< char[SP_SCENE_PATH_MAX], a file name ("": none) */
+  SP_KEY_PATH,  /**< char[SP_SCENE_PATH_MAX], a file name ("": none) */
+  SP_KEY_NAME   /**< sp_cell_name: a cell's name ("": none; name_valid) */
 } sp_key_type;
 
-static const char *const sp_key_type_names[] = {"float", "int", "uint",
-                                                 "bool", "enum", "path"};
+static const char *const sp_key_type_names[] = {"float", "int", "uint", "bool",
+                                                 "enum",  "path", "name"};
 
 /** How one end of an allowed range is closed. */
 typedef enum {
@@ -112,9 +148,10 @@ typedef struct {
   sp_section section;
   const char *name;
   sp_key_type type;
-  size_t offset;   /**< into sp_scene, or into sp_scene_cell for cells keys */
+  size_t offset;   /**< into sp_scene, or into the record of a sequence
+                        section (sp_scene_cell, sp_scene_lineage) */
   double fallback; /**< the default (enum/bool: the value of the word) */
-  int required;    /**< 1: no default, the key must be given (cells only) */
+  int required;    /**< 1: no default, the key must be given (sequences only) */
   sp_bound lower, upper;
   const cyaml_strval_t *words; /**< enum and bool: the accepted words */
   unsigned n_words;
@@ -157,6 +194,8 @@ static const cyaml_strval_t sp_shrink_words[] = {
     {"divisions", SP_SHRINK_DIVISIONS}, {"always", SP_SHRINK_ALWAYS}};
 static const cyaml_strval_t sp_fill_words[] = {{"edge", SP_FILL_EDGE},
                                                   {"relax", SP_FILL_RELAX}};
+static const cyaml_strval_t sp_axis_words[] = {
+    {"long", SP_AXIS_LONG}, {"fixed", SP_AXIS_FIXED}, {"perpendicular", SP_AXIS_PERPENDICULAR}};
 static const cyaml_strval_t sp_support_words[] = {
     {"auto", SP_SUPPORT_AUTO}, {"full", SP_SUPPORT_FULL}, {"local", SP_SUPPORT_LOCAL}};
 /* The YAML 1.1 booleans; the first word of each value is the one printed. */
@@ -211,6 +250,20 @@ _Static_assert(sizeof(sp_linear_kind) == sizeof(int), "enum size");
 #define CELL_ENUM(name, member, def, words, unit, meaning)                     \
   {SP_SEC_CELLS, name, SP_KEY_ENUM, ENUM_MEMBER_OFFSET(sp_scene_cell, member), \
    def, 0, UNBOUNDED, UNBOUNDED, words, CYAML_ARRAY_LEN(words), unit, meaning}
+/* A name key of a record (required or "": none) */
+#define NAME_KEY(sec, strct, name, member, required, meaning)                  \
+  {sec, name, SP_KEY_NAME,                                                     \
+   MEMBER_OFFSET(strct, member, char *) +                                      \
+       0 * sizeof(char[sizeof(((strct *)0)->member) == SP_CELL_NAME_MAX ? 1 : -1]), \
+   0.0, required, UNBOUNDED, UNBOUNDED, NULL, 0, "-", meaning}
+#define LINEAGE_FLOAT(name, member, def, lo, hi, unit, meaning)                \
+  {SP_SEC_LINEAGE, name, SP_KEY_FLOAT,                                         \
+   MEMBER_OFFSET(sp_scene_lineage, member, double), def, 0, lo, hi, NULL, 0,   \
+   unit, meaning}
+#define LINEAGE_ENUM(name, member, def, words, unit, meaning)                  \
+  {SP_SEC_LINEAGE, name, SP_KEY_ENUM,                                          \
+   ENUM_MEMBER_OFFSET(sp_scene_lineage, member), def, 0, UNBOUNDED, UNBOUNDED, \
+   words, CYAML_ARRAY_LEN(words), unit, meaning}
 
 /* Units: L = the model's length unit, T = its time unit, E = its energy per
  * unit area (the energy density of Pi); "-" = dimensionless. Defaults are
@@ -537,6 +590,38 @@ static const sp_key sp_keys[] = {
                         "radius of the c = 1/2 level set"),
     CELL_ENUM("profile", profile, SP_PROFILE_TANH, sp_profile_words, "-",
               "initial profile: tanh (equilibrium width d) or sharp (0/1)"),
+    NAME_KEY(SP_SEC_CELLS, sp_scene_cell, "name", name, 0,
+             "the cell's name (e.g. P0; unique; cells.csv and divisions.csv get a name "
+             "column when the scene names its cells); the lineage table refers to it"),
+    /* lineage: one mapping per named cell that divides by it (src/lineage.h) */
+    NAME_KEY(SP_SEC_LINEAGE, sp_scene_lineage, "cell", cell, 1,
+             "the dividing cell: an initial cell's name or a daughter of another entry"),
+    LINEAGE_FLOAT("age", age, NAN, ABOVE(0.0), UNBOUNDED, "T",
+                  "it divides at this age (after its birth); exactly one of age, time "
+                  "and mass_ratio"),
+    LINEAGE_FLOAT("time", time, NAN, ABOVE(0.0), UNBOUNDED, "T",
+                  "it divides at this time t (absolute; at once if born later)"),
+    LINEAGE_FLOAT("mass_ratio", mass_ratio, NAN, ABOVE(1.0), UNBOUNDED, "-",
+                  "it divides when its core mass reaches this x its birth core mass "
+                  "(as division.mass_ratio)"),
+    LINEAGE_FLOAT("fraction", fraction, 0.5, ABOVE(0.0), BELOW(1.0), "-",
+                  "the first daughter's share of the parent's mass (the cut is moved "
+                  "along its normal to give it: docs/model.md)"),
+    NAME_KEY(SP_SEC_LINEAGE, sp_scene_lineage, "first", first, 1,
+             "the first daughter's name: the side the cut's normal points away from"),
+    NAME_KEY(SP_SEC_LINEAGE, sp_scene_lineage, "second", second, 1,
+             "the second daughter's name: the side the normal points to"),
+    LINEAGE_ENUM("axis", axis, SP_AXIS_LONG, sp_axis_words, "-",
+                 "the cut's normal: long (the cell's long principal axis, the paper's "
+                 "rule), fixed (direction_x, _y, _z) or perpendicular (to the parent's "
+                 "own cut normal: turned by 90 degrees in 2D); long and perpendicular "
+                 "point to +x (then +y, +z), so the first daughter is the one at lower x"),
+    LINEAGE_FLOAT("direction_x", direction[0], NAN, UNBOUNDED, UNBOUNDED, "-",
+                  "axis fixed: x component of the cut's normal (any length > 0)"),
+    LINEAGE_FLOAT("direction_y", direction[1], NAN, UNBOUNDED, UNBOUNDED, "-",
+                  "axis fixed: y component of the cut's normal"),
+    LINEAGE_FLOAT("direction_z", direction[2], NAN, UNBOUNDED, UNBOUNDED, "-",
+                  "axis fixed: z component of the cut's normal (3D meshes only)"),
 };
 
 #define SP_N_KEYS (sizeof sp_keys / sizeof sp_keys[0])
@@ -585,15 +670,17 @@ static sp_section find_section(const char *name, size_t len) {
   return SP_N_SECTIONS;
 }
 
-/** "model.kappa", or "cells[3].x" (cell < 0: "cells[i].x"). */
+/** "model.kappa", or "cells[3].x", "lineage[0].cell" (cell < 0:
+ *  "cells[i].x"). */
 static const char *key_path(const sp_key *key, int cell, char *buf,
                             size_t size) {
-  if (key->section != SP_SEC_CELLS)
-    snprintf(buf, size, "%s.%s", sp_section_names[key->section], key->name);
+  const char *section = sp_section_names[key->section];
+  if (!is_sequence(key->section))
+    snprintf(buf, size, "%s.%s", section, key->name);
   else if (cell >= 0)
-    snprintf(buf, size, "cells[%d].%s", cell, key->name);
+    snprintf(buf, size, "%s[%d].%s", section, cell, key->name);
   else
-    snprintf(buf, size, "cells[i].%s", key->name);
+    snprintf(buf, size, "%s[i].%s", section, key->name);
   return buf;
 }
 
@@ -674,6 +761,10 @@ static const char *expectation(const sp_key *key, char *buf, size_t size) {
   case SP_KEY_PATH:
     snprintf(buf, size, "a file name of at most %d characters", SP_SCENE_PATH_MAX - 1);
     break;
+  case SP_KEY_NAME:
+    snprintf(buf, size, "a name of 1 to %d letters, digits, '_', '.' or '-'",
+             SP_CELL_NAME_MAX - 1);
+    break;
   default:
     range_text(key, range, sizeof range);
     if (key->lower.kind != SP_UNBOUNDED && key->upper.kind != SP_UNBOUNDED)
@@ -699,6 +790,20 @@ static int parse_number(const char *text, double *value) {
   return end != text && *end == '\0' && isfinite(*value);
 }
 
+/** 1 if @p text is a cell name: 1 to SP_CELL_NAME_MAX - 1 letters, digits,
+ *  '_', '.' or '-' (it goes into CSV columns and file names unquoted). */
+static int name_valid(const char *text) {
+  const size_t n = strlen(text);
+  if (n == 0 || n >= SP_CELL_NAME_MAX) return 0;
+  for (size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+          c == '_' || c == '.' || c == '-'))
+      return 0;
+  }
+  return 1;
+}
+
 /** 1 if @p value is allowed for @p key (range; integers: integral). */
 static int value_allowed(const sp_key *key, double value) {
   if (!isfinite(value)) return 0;
@@ -717,7 +822,8 @@ static int value_allowed(const sp_key *key, double value) {
 static void store_value(void *base, const sp_key *key, double value) {
   char *member = (char *)base + key->offset;
   switch (key->type) {
-  case SP_KEY_PATH: member[0] = '\0'; break; /* the default: none */
+  case SP_KEY_PATH:
+  case SP_KEY_NAME: member[0] = '\0'; break; /* the default: none */
   case SP_KEY_FLOAT: *(double *)member = value; break;
   case SP_KEY_UINT: *(unsigned *)member = (unsigned)value; break;
   default: *(int *)member = (int)value; break; /* int, bool, enum */
@@ -728,41 +834,50 @@ static void store_value(void *base, const sp_key *key, double value) {
 static double load_value(const void *base, const sp_key *key) {
   const char *member = (const char *)base + key->offset;
   switch (key->type) {
-  case SP_KEY_PATH: return 0.0; /* compared as text */
+  case SP_KEY_PATH:
+  case SP_KEY_NAME: return 0.0; /* compared as text */
   case SP_KEY_FLOAT: return *(const double *)member;
   case SP_KEY_UINT: return *(const unsigned *)member;
   default: return *(const int *)member; /* int, bool, enum */
   }
 }
 
+/** 1 if @p key's values in @p a and @p b (sp_scene or records) differ:
+ *  text compared as text, numbers bit for bit. */
+static int values_differ(const void *a, const void *b, const sp_key *key) {
+  if (key->type == SP_KEY_PATH || key->type == SP_KEY_NAME)
+    return strcmp((const char *)a + key->offset, (const char *)b + key->offset) != 0;
+  return memcmp(&(double){load_value(a, key)}, &(double){load_value(b, key)},
+                sizeof(double)) != 0;
+}
+
 int sp_scene_first_difference(const sp_scene *a, const sp_scene *b,
                               int (*skip)(const char *key), char *buf, size_t size) {
   for (size_t i = 0; i < SP_N_KEYS; ++i) {
     const sp_key *key = &sp_keys[i];
-    if (key->section == SP_SEC_CELLS) continue;
+    if (is_sequence(key->section)) continue;
     key_path(key, -1, buf, size);
     if (skip && skip(buf)) continue;
-    if (key->type == SP_KEY_PATH) {
-      if (strcmp((const char *)a + key->offset, (const char *)b + key->offset) != 0) return 1;
-    } else if (memcmp(&(double){load_value(a, key)}, &(double){load_value(b, key)},
-                      sizeof(double))) {
+    if (values_differ(a, b, key)) return 1;
+  }
+  for (int s = SP_N_MAPPINGS; s < SP_N_SECTIONS; ++s) {
+    const int n = sequence_count(a, (sp_section)s);
+    if (n != sequence_count(b, (sp_section)s)) {
+      snprintf(buf, size, "%s", sp_section_names[s]);
+      if (skip && skip(buf)) continue;
       return 1;
     }
+    for (int c = 0; c < n; ++c)
+      for (size_t i = 0; i < SP_N_KEYS; ++i) {
+        const sp_key *key = &sp_keys[i];
+        if (key->section != (sp_section)s) continue;
+        key_path(key, c + 1, buf, size);
+        if (skip && skip(buf)) continue;
+        if (values_differ(sequence_record(a, key->section, c),
+                          sequence_record(b, key->section, c), key))
+          return 1;
+      }
   }
-  if (a->n_cells != b->n_cells) {
-    snprintf(buf, size, "cells");
-    return !(skip && skip(buf));
-  }
-  for (int c = 0; c < a->n_cells; ++c)
-    for (size_t i = 0; i < SP_N_KEYS; ++i) {
-      const sp_key *key = &sp_keys[i];
-      if (key->section != SP_SEC_CELLS) continue;
-      key_path(key, c + 1, buf, size);
-      if (skip && skip(buf)) continue;
-      if (memcmp(&(double){load_value(&a->cells[c], key)},
-                 &(double){load_value(&b->cells[c], key)}, sizeof(double)))
-        return 1;
-    }
   return 0;
 }
 
@@ -783,6 +898,15 @@ static int store_slot(void *base, const sp_key *key, const void *slot,
   char path[SP_TEXT], expected[SP_LIST_TEXT];
   double value;
   const char *text = NULL;
+  if (key->type == SP_KEY_NAME) {
+    text = slot;
+    if (!name_valid(text))
+      return sp_error_set(SP_ERR_INPUT, "%s: %s: expected %s, got '%s'", where,
+                          key_path(key, cell, path, sizeof path),
+                          expectation(key, expected, sizeof expected), text);
+    strcpy((char *)base + key->offset, text);
+    return SP_OK;
+  }
   if (key->type == SP_KEY_PATH) {
     text = slot;
     if (strlen(text) >= SP_SCENE_PATH_MAX)
@@ -814,12 +938,13 @@ static int store_slot(void *base, const sp_key *key, const void *slot,
 /* The libcyaml schema, built from the table                                */
 /* ------------------------------------------------------------------------ */
 
-/** What libcyaml loads: per section an array of key slots (NULL = absent),
- *  and the cells as consecutive arrays of cell key slots. */
+/** What libcyaml loads: per mapping section an array of key slots (NULL =
+ *  absent), and per sequence section (cells, lineage) its entries as
+ *  consecutive arrays of key slots. */
 typedef struct {
-  void **section[SP_SEC_CELLS];
-  void **cells;
-  uint32_t n_cells;
+  void **section[SP_N_MAPPINGS];
+  void **entries[SP_N_SEQUENCES];
+  uint32_t n_entries[SP_N_SEQUENCES];
 } sp_raw_scene;
 
 /** The schema. It points into itself: build it in place, never copy it. */
@@ -827,7 +952,7 @@ typedef struct {
   /* every section's key fields, each list closed by an end entry */
   cyaml_schema_field_t key_fields[SP_N_KEYS + SP_N_SECTIONS];
   cyaml_schema_field_t section_fields[SP_N_SECTIONS + 1];
-  cyaml_schema_value_t cell;
+  cyaml_schema_value_t entry[SP_N_SEQUENCES]; /**< one entry of a sequence */
   cyaml_schema_value_t top;
 } sp_schema;
 
@@ -874,19 +999,22 @@ static void build_schema(sp_schema *schema) {
     ++n; /* the zeroed end entry */
     cyaml_schema_field_t *sf = &schema->section_fields[s];
     sf->key = sp_section_names[s];
-    if (s == SP_SEC_CELLS) {
-      schema->cell.type = CYAML_MAPPING;
-      schema->cell.flags = CYAML_FLAG_DEFAULT;
-      schema->cell.data_size = (uint32_t)(slots * sizeof(void *));
-      schema->cell.mapping.fields = first;
-      sf->data_offset = offsetof(sp_raw_scene, cells);
-      sf->count_offset = offsetof(sp_raw_scene, n_cells);
+    if (is_sequence((sp_section)s)) {
+      const int q = s - SP_N_MAPPINGS;
+      cyaml_schema_value_t *entry = &schema->entry[q];
+      entry->type = CYAML_MAPPING;
+      entry->flags = CYAML_FLAG_DEFAULT;
+      entry->data_size = (uint32_t)(slots * sizeof(void *));
+      entry->mapping.fields = first;
+      sf->data_offset = (uint32_t)(offsetof(sp_raw_scene, entries) + (size_t)q * sizeof(void **));
+      sf->count_offset =
+          (uint32_t)(offsetof(sp_raw_scene, n_entries) + (size_t)q * sizeof(uint32_t));
       sf->count_size = sizeof(uint32_t);
       sf->value.type = CYAML_SEQUENCE;
       /* cells: absent or empty is reported by sp_scene_load itself */
       sf->value.flags = CYAML_FLAG_POINTER_NULL | CYAML_FLAG_OPTIONAL;
-      sf->value.data_size = schema->cell.data_size;
-      sf->value.sequence.entry = &schema->cell;
+      sf->value.data_size = entry->data_size;
+      sf->value.sequence.entry = entry;
       sf->value.sequence.min = 0;
       sf->value.sequence.max = CYAML_UNLIMITED;
     } else {
@@ -1016,8 +1144,8 @@ static const char *path_expectation(const char *path, char *buf,
   } else if (s == SP_N_SECTIONS) {
     snprintf(buf, size, "a known section");
   } else if (path[head] == '\0') {
-    if (s == SP_SEC_CELLS)
-      snprintf(buf, size, "a sequence of cells, each a mapping of %s",
+    if (is_sequence(s))
+      snprintf(buf, size, "a sequence of %s entries, each a mapping of %s", sp_section_names[s],
                section_key_list(s, 0, list, sizeof list));
     else
       snprintf(buf, size, "a mapping of %s keys (%s)", sp_section_names[s],
@@ -1063,7 +1191,8 @@ static int report_cyaml_error(const char *file, cyaml_err_t err,
     return sp_error_set(SP_ERR_INPUT,
                         "%s: %s.%s: unknown key; %s has %s (libcyaml: %s)",
                         file, where.path, name,
-                        s == SP_SEC_CELLS ? "a cell" : where.path,
+                        s < SP_N_SECTIONS && is_sequence(s) ? sequence_of(s)->entry
+                                                            : where.path,
                         s < SP_N_SECTIONS
                             ? section_key_list(s, 0, list, sizeof list)
                             : "no such key",
@@ -1073,13 +1202,15 @@ static int report_cyaml_error(const char *file, cyaml_err_t err,
     backtrace_where(log, 1, &where);
     const char *name = strstr(message, missing_tag);
     name = name ? name + sizeof missing_tag - 1 : "?";
+    sp_section s = find_section(where.path, strcspn(where.path, ".["));
+    if (s == SP_N_SECTIONS || !is_sequence(s)) s = SP_SEC_CELLS;
     return sp_error_set(SP_ERR_INPUT,
-                        "%s: %s%s%s: missing; every cell needs %s "
+                        "%s: %s%s%s: missing; every %s needs %s "
                         "(libcyaml: %s)",
                         file_line(file, where.line, at, sizeof at),
                         where.path, where.path[0] ? "." : "", name,
-                        section_key_list(SP_SEC_CELLS, 1, list, sizeof list),
-                        message);
+                        sequence_of(s)->entry + 2, /* "cell", "lineage entry" */
+                        section_key_list(s, 1, list, sizeof list), message);
   }
   backtrace_where(log, 0, &where);
   if (err == CYAML_ERR_LIBYAML_PARSER) {
@@ -1169,8 +1300,7 @@ static int apply_raw(sp_scene *scene, const sp_raw_scene *raw,
                      const char *file) {
   for (size_t i = 0; i < SP_N_KEYS; ++i) {
     const sp_key *key = &sp_keys[i];
-    void **slots = key->section == SP_SEC_CELLS ? NULL
-                                                : raw->section[key->section];
+    void **slots = is_sequence(key->section) ? NULL : raw->section[key->section];
     if (slots && slots[key_slot(key)])
       SP_CALL(store_slot(scene, key, slots[key_slot(key)], file, -1));
   }
@@ -1190,17 +1320,24 @@ static int apply_raw(sp_scene *scene, const sp_raw_scene *raw,
   }
   /* libcyaml loads "cells: []", "cells:" and no cells key alike; none is
    * right only with initial.from or initial.label_image (check_initial) */
-  SP_ALLOC(scene->cells, raw->n_cells);
-  scene->n_cells = (int)raw->n_cells;
-  size_t n_cell_keys = section_key_count(SP_SEC_CELLS);
-  for (int c = 0; c < scene->n_cells; ++c) {
-    void **slots = raw->cells + (size_t)c * n_cell_keys;
-    store_defaults(&scene->cells[c], SP_SEC_CELLS);
-    for (size_t i = 0; i < SP_N_KEYS; ++i) {
-      const sp_key *key = &sp_keys[i];
-      if (key->section == SP_SEC_CELLS && slots[key_slot(key)])
-        SP_CALL(store_slot(&scene->cells[c], key, slots[key_slot(key)], file,
-                           c));
+  for (int s = SP_N_MAPPINGS; s < SP_N_SECTIONS; ++s) {
+    const sp_sequence *q = sequence_of((sp_section)s);
+    const uint32_t n = raw->n_entries[s - SP_N_MAPPINGS];
+    char *records = calloc(n ? n : 1, q->size);
+    SP_CHECK(records, SP_ERR_MEMORY, "%s: out of memory for %u %s entries", file, n,
+             sp_section_names[s]);
+    *(char **)((char *)scene + q->records) = records;
+    *(int *)((char *)scene + q->count) = (int)n;
+    const size_t n_keys = section_key_count((sp_section)s);
+    for (uint32_t c = 0; c < n; ++c) {
+      void **slots = raw->entries[s - SP_N_MAPPINGS] + (size_t)c * n_keys;
+      void *record = records + (size_t)c * q->size;
+      store_defaults(record, (sp_section)s);
+      for (size_t i = 0; i < SP_N_KEYS; ++i) {
+        const sp_key *key = &sp_keys[i];
+        if (key->section == (sp_section)s && slots[key_slot(key)])
+          SP_CALL(store_slot(record, key, slots[key_slot(key)], file, (int)c));
+      }
     }
   }
   return SP_OK;
@@ -1255,10 +1392,10 @@ static int apply_override(sp_scene *scene, const char *arg) {
   SP_CHECK(s != SP_N_SECTIONS, SP_ERR_INPUT,
            "%s: %.*s: unknown section; the sections are %s", where,
            (int)name_len, arg, section_list(list, sizeof list));
-  SP_CHECK(s != SP_SEC_CELLS, SP_ERR_INPUT,
-           "%s: %.*s: cells cannot be set from the command line; edit the "
-           "cells list of the scene file",
-           where, (int)name_len, arg);
+  SP_CHECK(!is_sequence(s), SP_ERR_INPUT,
+           "%s: %.*s: %s cannot be set from the command line; edit the "
+           "%s list of the scene file",
+           where, (int)name_len, arg, sp_section_names[s], sp_section_names[s]);
   const sp_key *key = find_key(s, dot + 1, (size_t)(eq - dot - 1));
   SP_CHECK(key, SP_ERR_INPUT, "%s: %.*s: unknown key; %s has %s", where,
            (int)name_len, arg, sp_section_names[s],
@@ -1379,6 +1516,8 @@ static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
   SP_CHECK(scene->division.criterion == SP_DIVIDE_NONE, SP_ERR_INPUT,
            "%s: division.criterion: divisions are " SP_NOT_YET_3D ": expected none", file);
+  SP_CHECK(scene->n_lineage == 0, SP_ERR_INPUT,
+           "%s: lineage: divisions are " SP_NOT_YET_3D ": expected no lineage table", file);
   SP_CHECK(scene->shape.delta1 == 0, SP_ERR_INPUT,
            "%s: shape.delta1: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
            scene->shape.delta1);
@@ -1500,6 +1639,133 @@ static int check_cells(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
+/** The initial cell named @p name, or -1. */
+static int initial_named(const sp_scene *scene, const char *name) {
+  for (int i = 0; i < scene->n_cells; ++i)
+    if (strcmp(scene->cells[i].name, name) == 0) return i;
+  return -1;
+}
+
+/** The lineage entry with @p name as a daughter (*which: "first" or
+ *  "second"), from entry @p from on, or -1. */
+static int daughter_entry(const sp_scene *scene, const char *name, int from, const char **which) {
+  for (int j = from; j < scene->n_lineage; ++j) {
+    const sp_scene_lineage *e = &scene->lineage[j];
+    if (strcmp(e->first, name) == 0 || strcmp(e->second, name) == 0) {
+      *which = strcmp(e->first, name) == 0 ? "first" : "second";
+      return j;
+    }
+  }
+  return -1;
+}
+
+/** One lineage entry's own keys: one criterion, a fixed axis's direction. */
+static int check_lineage_entry(const sp_scene *scene, int i, const char *file) {
+  const sp_scene_lineage *e = &scene->lineage[i];
+  const int dim = sp_scene_dim(scene);
+  const double when[3] = {e->age, e->time, e->mass_ratio};
+  static const char *const when_key[3] = {"age", "time", "mass_ratio"};
+  int given = 0;
+  char list[SP_TEXT] = "";
+  for (int k = 0; k < 3; ++k)
+    if (!isnan(when[k])) {
+      ++given;
+      snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", given > 1 ? ", " : "",
+               when_key[k]);
+    }
+  SP_CHECK(given == 1, SP_ERR_INPUT,
+           "%s: lineage[%d].age, lineage[%d].time, lineage[%d].mass_ratio: expected exactly "
+           "one (when '%s' divides), got %s%s",
+           file, i, i, i, e->cell, given ? list : "none", given ? "" : " of them");
+  static const char *const axis_key[3] = {"direction_x", "direction_y", "direction_z"};
+  double norm2 = 0;
+  for (int d = 0; d < 3; ++d) {
+    const int wanted = e->axis == SP_AXIS_FIXED && d < dim;
+    SP_CHECK(wanted || isnan(e->direction[d]), SP_ERR_INPUT,
+             "%s: lineage[%d].%s: expected none %s, got %.15g", file, i, axis_key[d],
+             d >= dim ? "on a 2D mesh (no z)" : "unless axis is fixed", e->direction[d]);
+    SP_CHECK(!wanted || !isnan(e->direction[d]), SP_ERR_INPUT,
+             "%s: lineage[%d].%s: missing; axis fixed needs the cut's normal direction_x, "
+             "direction_y%s",
+             file, i, axis_key[d], dim == 3 ? ", direction_z" : "");
+    if (wanted) norm2 += e->direction[d] * e->direction[d];
+  }
+  SP_CHECK(e->axis != SP_AXIS_FIXED || norm2 > 0, SP_ERR_INPUT,
+           "%s: lineage[%d].direction_x: expected a nonzero direction (the cut's normal), "
+           "got the zero vector", file, i);
+  SP_CHECK(strcmp(e->first, e->second) != 0, SP_ERR_INPUT,
+           "%s: lineage[%d].second: expected a name other than first's, got '%s' twice", file,
+           i, e->second);
+  return SP_OK;
+}
+
+/** Entry @p i's place in the table: its cell has no other entry, its
+ *  daughters' names are new, and its cell is reached from an initial cell
+ *  (perpendicular needs a parent's cut). */
+static int check_lineage_place(const sp_scene *scene, int i, const char *file) {
+  const sp_scene_lineage *e = &scene->lineage[i];
+  for (int j = 0; j < i; ++j)
+    SP_CHECK(strcmp(scene->lineage[j].cell, e->cell) != 0, SP_ERR_INPUT,
+             "%s: lineage[%d].cell: '%s' has an entry already (lineage[%d]): a cell "
+             "divides once", file, i, e->cell, j);
+  const char *daughter[2] = {e->first, e->second}, *key[2] = {"first", "second"}, *which;
+  for (int d = 0; d < 2; ++d) {
+    const int k = initial_named(scene, daughter[d]);
+    SP_CHECK(k < 0, SP_ERR_INPUT,
+             "%s: lineage[%d].%s: expected a new name, got '%s', the name of cells[%d]",
+             file, i, key[d], daughter[d], k);
+    const int j = daughter_entry(scene, daughter[d], i + 1, &which);
+    SP_CHECK(j < 0, SP_ERR_INPUT,
+             "%s: lineage[%d].%s: '%s' is a daughter of two entries: also "
+             "lineage[%d].%s", file, j, which, daughter[d], i, key[d]);
+  }
+  /* the cell's ancestry: up the table to an initial cell */
+  const char *name = e->cell;
+  int parent = -1;
+  for (int up = 0; initial_named(scene, name) < 0; ++up) {
+    const int j = daughter_entry(scene, name, 0, &which);
+    SP_CHECK(j >= 0, SP_ERR_INPUT,
+             "%s: lineage[%d].cell: unknown name '%s': expected an initial cell's name "
+             "(cells[i].name) or a daughter of another entry (first, second)",
+             file, i, name);
+    SP_CHECK(up < scene->n_lineage, SP_ERR_INPUT,
+             "%s: lineage[%d].cell: '%s' is its own ancestor (a cycle through "
+             "lineage[%d].%s): the table must lead down from the initial cells",
+             file, i, e->cell, j, which);
+    if (parent < 0) parent = j;
+    name = scene->lineage[j].cell;
+  }
+  SP_CHECK(e->axis != SP_AXIS_PERPENDICULAR || parent >= 0, SP_ERR_INPUT,
+           "%s: lineage[%d].axis: perpendicular needs the parent's cut, but '%s' is an "
+           "initial cell: expected long or fixed", file, i, e->cell);
+  return SP_OK;
+}
+
+/** The names and the lineage table: names unique; every entry's cell an
+ *  initial cell or a daughter of another entry, once; every daughter's name
+ *  new; no cycle; perpendicular only for a cell that has a parent. */
+static int check_lineage(const sp_scene *scene, const char *file) {
+  int named = 0;
+  for (int i = 0; i < scene->n_cells; ++i) {
+    const char *name = scene->cells[i].name;
+    if (!name[0]) continue;
+    ++named;
+    const int first = initial_named(scene, name);
+    SP_CHECK(first == i, SP_ERR_INPUT,
+             "%s: cells[%d].name: expected a name of its own, got '%s', the name of cells[%d]",
+             file, i, name, first);
+  }
+  if (scene->n_lineage == 0) return SP_OK;
+  SP_CHECK(named > 0, SP_ERR_INPUT,
+           "%s: lineage: expected named cells (cells[i].name), got none: the table's "
+           "cell, first and second refer to names", file);
+  for (int i = 0; i < scene->n_lineage; ++i) {
+    SP_CALL(check_lineage_entry(scene, i, file));
+    SP_CALL(check_lineage_place(scene, i, file));
+  }
+  return SP_OK;
+}
+
 /** The initial layout (every cell on every node: a run starts with it, also
  *  before cutting local supports) must be numberable by ints and Epetra's
  *  32-bit global ids; checked here, before anything that large is allocated. */
@@ -1530,7 +1796,8 @@ static int check_sizes(const sp_scene *scene, const char *file) {
    * solver: its matrix's nonzeros must fit too (sp_nonzeros_bound). Local
    * supports are checked when each layout is handed over (the run's). */
   const int full = scene->layout.support == SP_SUPPORT_FULL ||
-                   (scene->layout.support == SP_SUPPORT_AUTO && scene->n_cells <= 4 &&
+                   (scene->layout.support == SP_SUPPORT_AUTO &&
+                    scene->n_cells + scene->n_lineage <= 4 &&
                     scene->division.criterion == SP_DIVIDE_NONE);
   const int dim = sp_scene_dim(scene);
   const long long nonzeros = sp_nonzeros_bound(dim, nodes, scene->n_cells);
@@ -1553,7 +1820,7 @@ static int check_sizes(const sp_scene *scene, const char *file) {
  *  frees the scene on failure, so this may return from anywhere. */
 static int fill_scene(sp_scene *scene, const char *path, const char *text,
                       size_t len, int n_set, const char *const *set) {
-  for (int s = 0; s < SP_SEC_CELLS; ++s) store_defaults(scene, (sp_section)s);
+  for (int s = 0; s < SP_N_MAPPINGS; ++s) store_defaults(scene, (sp_section)s);
   SP_CALL(text ? load_text(scene, path, text, len) : load_file(scene, path));
   for (int i = 0; i < n_set; ++i) SP_CALL(apply_override(scene, set[i]));
   /* a clash may come from an override: say so in the prefix */
@@ -1564,6 +1831,7 @@ static int fill_scene(sp_scene *scene, const char *path, const char *text,
   SP_CALL(check_3d(scene, where));
   SP_CALL(check_initial(scene, where));
   SP_CALL(check_cells(scene, where));
+  SP_CALL(check_lineage(scene, where));
   SP_CALL(check_sizes(scene, where));
   return SP_OK;
 }
@@ -1615,12 +1883,14 @@ void sp_scene_print_keys(FILE *out) {
       word_list(key, range, sizeof range);
     else if (key->type == SP_KEY_PATH)
       snprintf(range, sizeof range, "a file");
+    else if (key->type == SP_KEY_NAME)
+      snprintf(range, sizeof range, "1 to %d of A-Z a-z 0-9 _ . -", SP_CELL_NAME_MAX - 1);
     else
       range_text(key, range, sizeof range);
-    if (key->type == SP_KEY_PATH)
-      snprintf(fallback, sizeof fallback, "none");
-    else if (key->required)
+    if (key->required)
       snprintf(fallback, sizeof fallback, "required");
+    else if (key->type == SP_KEY_PATH || key->type == SP_KEY_NAME)
+      snprintf(fallback, sizeof fallback, "none");
     else if (key->type == SP_KEY_BOOL || key->type == SP_KEY_ENUM)
       snprintf(fallback, sizeof fallback, "%s", word_of(key, key->fallback));
     else if (isnan(key->fallback))
@@ -1637,6 +1907,7 @@ void sp_scene_print_keys(FILE *out) {
 void sp_scene_destroy(sp_scene **scene) {
   if (!scene || !*scene) return;
   free((*scene)->cells);
+  free((*scene)->lineage);
   free(*scene);
   *scene = NULL;
 }

@@ -12,6 +12,8 @@
 #include <stddef.h>
 #include <stdio.h>
 
+#include "cell_obs.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -88,7 +90,28 @@ typedef struct {
                         given) on a 2D one */
   double radius;   /**< radius of the c = 1/2 level set */
   sp_profile_kind profile; /**< tanh (equilibrium width) or sharp */
+  char name[SP_CELL_NAME_MAX]; /**< its name ("": none; lineage.h) */
 } sp_scene_cell;
+
+/** The cut's normal rule of a lineage entry (src/lineage.h). */
+typedef enum {
+  SP_AXIS_LONG = 0,          /**< normal along the cell's long axis (the paper's) */
+  SP_AXIS_FIXED = 1,         /**< normal = direction_x, _y (, _z) */
+  SP_AXIS_PERPENDICULAR = 2  /**< normal perpendicular to the parent's cut normal */
+} sp_axis_kind;
+
+/** One entry of the lineage table: how the cell named @c cell divides. */
+typedef struct {
+  char cell[SP_CELL_NAME_MAX];   /**< the dividing cell's name */
+  double age;        /**< divide at this age (NaN: not this criterion) */
+  double time;       /**< ... at this absolute time (NaN: not this one) */
+  double mass_ratio; /**< ... at this x its birth mass (NaN: not this one) */
+  double fraction;   /**< the first daughter's share of the parent's mass */
+  char first[SP_CELL_NAME_MAX];  /**< the first daughter's name */
+  char second[SP_CELL_NAME_MAX]; /**< the second daughter's name */
+  sp_axis_kind axis;             /**< the cut's normal */
+  double direction[3]; /**< axis fixed: the normal (x, y, z; NaN: not given) */
+} sp_scene_lineage;
 
 /** noise: the initial background of every field. */
 typedef struct {
@@ -217,6 +240,8 @@ typedef struct sp_scene {
   sp_scene_initial initial;
   int n_cells;         /**< 0 when initial.from or initial.label_image gives the cells */
   sp_scene_cell *cells;
+  int n_lineage;       /**< entries of the lineage table (0: none) */
+  sp_scene_lineage *lineage;
 } sp_scene;
 
 /**

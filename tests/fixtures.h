@@ -17,6 +17,28 @@
 #include "resize.h"
 #include "stepper.h"
 
+/** A division's set-up: a 160 x 160 mesh of the unit square, full layouts
+ *  of 1 cell (the parent) and 2 (the daughters), their states zeroed;
+ *  split_teardown frees them. */
+static inline void split_setup(sp_mesh **mesh, sp_layout **layout, sp_layout **new_layout,
+                               double **state, double **new_state) {
+  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 160, 160, mesh));
+  CHECK_OK(sp_layout_create_full((*mesh)->n_nodes, 1, layout));
+  CHECK_OK(sp_layout_create_full((*mesh)->n_nodes, 2, new_layout));
+  *state = calloc(2 * (size_t)(*layout)->n_pairs, sizeof(double));
+  *new_state = calloc(2 * (size_t)(*new_layout)->n_pairs, sizeof(double));
+}
+
+static inline void split_teardown(sp_mesh **mesh, sp_layout **layout, sp_layout **new_layout,
+                                  double **state, double **new_state) {
+  free(*state);
+  free(*new_state);
+  *state = *new_state = NULL;
+  sp_layout_destroy(layout);
+  sp_layout_destroy(new_layout);
+  sp_mesh_destroy(mesh);
+}
+
 /** The paper's parameters (table 1). */
 static inline sp_model_params paper_model(void) {
   sp_model_params m = {.alpha = 4, .kappa = 1e-3, .lambda = 100, .lambda_b = 100, .mobility = 1};

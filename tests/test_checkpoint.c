@@ -1,8 +1,9 @@
 /* Checkpoints alone (src/checkpoint.c), no time stepping:
  * - a round trip of the run state: a run set up from a scene as a run is
  *   (scene_fixture.h), moved to random supports with every member set (two
- *   past states, a registry, the controller, the counters, the energy
- *   history), is written, and a run set up from the checkpoint as a
+ *   past states, a registry with names and cut normals, the controller,
+ *   the counters, the energy history), is written, and a run set up from
+ *   the checkpoint as a
  *   restart is compares equal to it member by member, bit for bit;
  * - output.checkpoint_keep keeps the newest files only, and the newest
  *   valid one is found past a damaged newer one;
@@ -73,6 +74,11 @@ static scene_run *fill_run(const sp_scene *scene) {
     run->cells.source_on[k] = k != 1;
     run->cells.division_skipped[k] = k == 2;
     run->cells.divided_now[k] = k == 0;
+    /* names (the lineage table's, up to SP_CELL_NAME_MAX - 1 characters;
+     * the last cell unnamed) and the normals of the cuts that made them */
+    static const char *const names[] = {"P0", "ABCDEFGHIJKLMNOPQRSTUVWXYZabcde", ""};
+    snprintf(run->cells.name[k], SP_CELL_NAME_MAX, "%s", names[k]);
+    for (int d = 0; d < 3; ++d) run->cells.cut_normal[k][d] = uniform();
   }
   run->dtc = (sp_dt_control){.dt_next = uniform(), .failures = 2, .successes = 3,
                              .ceiling = uniform(), .ceiling_steps = 4, .since_restart = 5,
@@ -127,6 +133,9 @@ static int differences(const sp_run *a, const sp_run *b, int say) {
              b->cells.division_skipped[k] == a->cells.division_skipped[k] &&
              b->cells.divided_now[k] == a->cells.divided_now[k],
          "registry");
+    DIFF(strcmp(b->cells.name[k], a->cells.name[k]) == 0, "name");
+    DIFF(!memcmp(b->cells.cut_normal[k], a->cells.cut_normal[k], sizeof a->cells.cut_normal[k]),
+         "cut normal");
   }
   sp_dt_control da = a->dtc, db = b->dtc;
   db.p = da.p; /* the parameters come from the scene */

@@ -475,11 +475,8 @@ static void set_egg(const sp_mesh *mesh, const sp_layout *layout, double *state,
 static void test_equal_mass_line(void) {
   sp_mesh *mesh;
   sp_layout *layout, *new_layout;
-  CHECK_OK(sp_mesh_rectangle(0, 0, 1, 1, 160, 160, &mesh));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
-  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 2, &new_layout));
-  double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
-  double *new_state = calloc(2 * (size_t)new_layout->n_pairs, sizeof(double));
+  double *state, *new_state;
+  split_setup(&mesh, &layout, &new_layout, &state, &new_state);
   const double width = interface_width();
   printf("  equal-mass line | cut    | offset    | centre line: daughters off by | "
          "equal mass: off by\n");
@@ -495,7 +492,7 @@ static void test_equal_mass_line(void) {
       for (int balanced = 0; balanced <= 1; ++balanced) {
         if (balanced)
           CHECK_OK(sp_division_balance_offset(mesh, layout, state, 0, &before, smooth, width,
-                                              &offset));
+                                              0.5, &offset));
         CHECK_OK(sp_division_split(mesh, layout, state, 0, &before, smooth, width,
                                    balanced ? offset : 0.0, new_layout, new_state, 1));
         CHECK_OK(sp_cells_observe(mesh, new_layout, new_state, WEIGHT_THRESHOLD, after));
@@ -523,11 +520,7 @@ static void test_equal_mass_line(void) {
               offset);
       }
     }
-  free(state);
-  free(new_state);
-  sp_layout_destroy(&layout);
-  sp_layout_destroy(&new_layout);
-  sp_mesh_destroy(&mesh);
+  split_teardown(&mesh, &layout, &new_layout, &state, &new_state);
 }
 
 /* Which daughter takes the new label follows v1's sign. For a cut along

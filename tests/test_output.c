@@ -168,8 +168,8 @@ int main(void) {
   memset(obs, 0, sizeof obs);
   obs[0].mass = 0.1 / 3.0, obs[0].xc = 0.25, obs[0].angle = -1.0 / 7.0;
   obs[1].mass = 2.0 / 3.0, obs[1].I1 = 1e-8 / 3.0;
-  CHECK_OK(sp_output_cells(out, 0, 0.0, 2, obs));
-  CHECK_OK(sp_output_cells(out, 10, tv[1], 2, obs));
+  CHECK_OK(sp_output_cells(out, 0, 0.0, 2, obs, NULL));
+  CHECK_OK(sp_output_cells(out, 10, tv[1], 2, obs, NULL));
 
   /* ---- two field outputs (the second on the masked layout) ---- */
   CHECK_OK(sp_output_fields(out, &mesh, full, state, 10, tv[1]));

@@ -359,7 +359,7 @@ static int load_dir(const char *relative) {
 }
 
 static void test_shipped_scenes(void) {
-  const int n = load_dir("inputs") + load_dir("inputs/paper");
+  const int n = load_dir("inputs") + load_dir("inputs/paper") + load_dir("inputs/embryo");
   CHECK(n >= 11, "only %d scenes under inputs/", n);
 }
 

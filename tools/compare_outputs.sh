@@ -29,6 +29,7 @@ export OMP_NUM_THREADS=1
 declare -A cut=(
   [inputs/default.yaml]=30
   [inputs/divide_1_2_4.yaml]=60
+  [inputs/embryo/lineage_4.yaml]=100
   [inputs/label_image.yaml]=20
   [inputs/aggregate_256.yaml]=14
   [inputs/bench/relax_3.yaml]=20
