@@ -406,6 +406,7 @@ struct sp_checkpoint_s {
   const char **set;
   int n_set;
   int step, mpi_size;
+  int version; /* the file's format version (1: no names, no cut normals) */
   double t;
   int header[HEADER_INTS];
   double header_t[HEADER_DOUBLES];
@@ -480,10 +481,11 @@ int sp_checkpoint_open(const char *path, sp_checkpoint *out) {
                                     "attribute is %s%s%s)", path, format ? "'" : "missing",
                       format ? format : "", format ? "'" : "");
   else if (H5LTget_attribute_int(ck->file, "/", "format_version", &version) < 0 ||
-           version != SP_CHECKPOINT_VERSION)
+           version < SP_CHECKPOINT_VERSION_OLDEST || version > SP_CHECKPOINT_VERSION)
     rc = sp_error_set(SP_ERR_INPUT, "checkpoint '%s': format version %d, this softpack (%s) "
-                                    "reads version %d", path, version, sp_version(),
-                      SP_CHECKPOINT_VERSION);
+                                    "reads versions %d to %d", path, version, sp_version(),
+                      SP_CHECKPOINT_VERSION_OLDEST, SP_CHECKPOINT_VERSION);
+  ck->version = version;
   free(format);
   if (rc == SP_OK) rc = get_array(ck, "/header", H5T_NATIVE_INT, ck->header, HEADER_INTS);
   if (rc == SP_OK) rc = get_array(ck, "/header_t", H5T_NATIVE_DOUBLE, ck->header_t, HEADER_DOUBLES);
@@ -728,6 +730,11 @@ static int read_registry(const sp_checkpoint ck, sp_registry *cells, int nc) {
   SP_CALL(get_array(ck, "/cells/source_on", H5T_NATIVE_INT, cells->source_on, nc));
   SP_CALL(get_array(ck, "/cells/division_skipped", H5T_NATIVE_INT, cells->division_skipped, nc));
   SP_CALL(get_array(ck, "/cells/divided_now", H5T_NATIVE_UCHAR, cells->divided_now, nc));
+  if (ck->version < 2) { /* written before names and cut normals: none */
+    memset(cells->name, 0, (size_t)nc * SP_CELL_NAME_MAX);
+    memset(cells->cut_normal, 0, 3 * (size_t)nc * sizeof(double));
+    return SP_OK;
+  }
   SP_CALL(get_array(ck, "/cells/name", H5T_NATIVE_CHAR, cells->name,
                     (size_t)nc * SP_CELL_NAME_MAX));
   for (int k = 0; k < nc; ++k) cells->name[k][SP_CELL_NAME_MAX - 1] = '\0';

@@ -48,6 +48,9 @@ extern "C" {
 /** The checkpoint format this build writes and reads (2: the registry
  *  holds the cells' names and cut normals, lineage.h). */
 #define SP_CHECKPOINT_VERSION 2
+/** The oldest format it still reads (a version 1 file restores with no
+ *  names and no cut normals: it was written before they existed). */
+#define SP_CHECKPOINT_VERSION_OLDEST 1
 
 /** An open checkpoint (sp_checkpoint_open). */
 typedef struct sp_checkpoint_s *sp_checkpoint;

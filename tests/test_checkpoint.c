@@ -303,6 +303,29 @@ static void bad_files(const sp_scene *scene) {
   H5Fclose(h);
   refused(DIR "/version.h5", "format version");
   refused(DIR "/missing.h5", "cannot read");
+  /* a version 1 file (before names and cut normals) restores the same
+   * state with unnamed cells */
+  copy_file(good, DIR "/v1.h5");
+  h = H5Fopen(DIR "/v1.h5", H5F_ACC_RDWR, H5P_DEFAULT);
+  const int v1 = 1;
+  H5LTset_attribute_int(h, "/", "format_version", &v1, 1);
+  H5Ldelete(h, "/cells/name", H5P_DEFAULT);
+  H5Ldelete(h, "/cells/cut_normal", H5P_DEFAULT);
+  H5Fclose(h);
+  scene_run *g1, *r1;
+  CHECK_OK(restore(good, scene, &g1));
+  CHECK_OK(restore(DIR "/v1.h5", scene, &r1));
+  if (g1 && r1) {
+    const sp_run *a = &g1->run, *b = &r1->run;
+    CHECK(b->layout->n_pairs == a->layout->n_pairs &&
+              !memcmp(a->state, b->state, sizeof(double) * 2 * (size_t)a->layout->n_pairs),
+          "version 1: another state restored");
+    int named = 0;
+    for (int k = 0; k < b->cells.n; ++k) named += b->cells.name[k][0] != '\0';
+    CHECK(named == 0, "version 1: %d cells named", named);
+  }
+  scene_run_free(&g1);
+  scene_run_free(&r1);
 }
 
 int main(int argc, char **argv) {
