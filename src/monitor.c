@@ -29,6 +29,20 @@ static int append(double **array, int *n, double x) {
   return SP_OK;
 }
 
+/** The contacts of the current state into mon->contacts (output.contacts):
+ *  each rank integrates the elements it assembles, then one reduction.
+ *  Collective. */
+static int measure_contacts(sp_run *run) {
+  int *first_node;
+  SP_ALLOC(first_node, (size_t)run->n_ranks + 1);
+  sp_partition_ranges(run->layout, run->n_ranks, first_node);
+  int rc = sp_contacts_integrate(run->mesh, run->layout, run->state, first_node[run->rank],
+                                 first_node[run->rank + 1], &run->mon.contacts);
+  free(first_node);
+  SP_CALL(sp_agree(run->agree_comm, rc)); /* a collective follows */
+  return sp_contacts_reduce(run->agree_comm, &run->mon.contacts);
+}
+
 /** Energy and observables rows of the current state (the registry's
  *  observables are those of the state: every change of the state refreshes
  *  them). @p known: the field energy of this state if already computed
@@ -55,11 +69,15 @@ static int record_energy(sp_run *run, double dt, int its, const sp_step_costs *c
   }
   mon->energy_t[mon->n_energy] = run->t;
   mon->energy_total[mon->n_energy++] = total;
+  if (run->opt.output.contacts) SP_CALL(measure_contacts(run));
   if (run->rank != 0) return SP_OK;
   SP_CALL(sp_output_energy(mon->output, run->step, run->t, dt, its, n_cells, &parts, shape,
                            costs));
-  return sp_output_cells(mon->output, run->step, run->t, n_cells, run->cells.obs,
-                         run->cells.name);
+  SP_CALL(sp_output_cells(mon->output, run->step, run->t, n_cells, run->cells.obs,
+                          run->cells.name));
+  if (!run->opt.output.contacts) return SP_OK;
+  return sp_contacts_log_write(&mon->contacts_log, run->step, run->t, &mon->contacts,
+                               run->cells.obs, run->opt.output.contact_threshold);
 }
 
 /** The fields of the state: a piece per rank and the .pvtu by rank 0 under
@@ -93,6 +111,12 @@ static int write_snapshot(sp_run *run) {
     snprintf(path, sizeof path, "%s/cells_%06d.png", sp_output_dir(mon->output), run->step);
     SP_CALL(sp_render_cells(run->mesh, run->layout, run->state, run->t,
                             run->opt.output.picture_width, path));
+    if (run->opt.output.contacts) {
+      snprintf(path, sizeof path, "%s/contacts_%06d.png", sp_output_dir(mon->output), run->step);
+      SP_CALL(sp_contacts_picture(&mon->contacts, run->mesh, run->cells.obs,
+                                  run->opt.output.contact_threshold, run->t,
+                                  run->opt.output.picture_width, path));
+    }
   }
   snprintf(path, sizeof path, "%s/energy.png", sp_output_dir(mon->output));
   return sp_render_energy(mon->energy_t, mon->energy_total, mon->n_energy, mon->division_t,
@@ -110,6 +134,9 @@ int sp_monitor_open(sp_run *run) {
     } else {
       rc = sp_output_open_dim(mon->out_dir, run->mesh->dim, run->lineage.named, &mon->output);
     }
+    if (rc == SP_OK && run->opt.output.contacts)
+      rc = sp_contacts_log_open(mon->out_dir, run->restarted ? run->step : -1,
+                                &mon->contacts_log);
   }
   free(mon->fields);
   mon->fields = NULL;
@@ -349,6 +376,8 @@ void sp_monitor_end(sp_run *run) {
 
 void sp_monitor_free(sp_monitor *mon) {
   sp_output_close(&mon->output);
+  sp_contacts_log_close(&mon->contacts_log);
+  sp_contacts_clear(&mon->contacts);
   free(mon->energy_t);
   free(mon->energy_total);
   free(mon->division_t);

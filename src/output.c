@@ -327,6 +327,20 @@ int sp_output_open_dim(const char *dir, int dim, int named, sp_output *out) {
   return output_open(dir, dim, named, -1, out);
 }
 
+int sp_output_log_open(const char *dir, const char *name, const char *header,
+                       int step_column, int resume_step, FILE **f, char **path) {
+  *f = NULL;
+  *path = sp_strfmt("%s/%s", dir, name);
+  SP_CHECK(*path, SP_ERR_MEMORY, "out of memory naming '%s' in '%s'", name, dir);
+  int exists = 0;
+  if (resume_step >= 0) SP_CALL(sp_log_cut(*path, step_column, resume_step, &exists));
+  return sp_log_open(*path, exists ? NULL : header, f);
+}
+
+int sp_output_log_done(FILE *f, const char *path, int printed) {
+  return sp_log_done(f, path, printed);
+}
+
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,
                      double shape, const sp_step_costs *seconds) {

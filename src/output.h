@@ -7,6 +7,8 @@
 #ifndef SP_OUTPUT_H
 #define SP_OUTPUT_H
 
+#include <stdio.h>
+
 #include "cells.h"
 #include "division.h"
 #include "layout.h"
@@ -138,6 +140,21 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
  *         share of the first daughter; empty for a division by the scene's
  *         division: rules). */
 int sp_output_division(sp_output out, double t, int step, const sp_division_record *d);
+
+/**
+ * @brief Another CSV log of the output directory (contacts.csv), kept by
+ *        its module: @p dir/@p name started with @p header (@p resume_step
+ *        < 0), or, continuing a run, cut back like the others to the rows
+ *        whose column @p step_column is a step <= @p resume_step and
+ *        appended to. Rows are fprintf'd to *@p f and checked with
+ *        sp_output_log_done; the caller closes *@p f and frees *@p path.
+ */
+int sp_output_log_open(const char *dir, const char *name, const char *header,
+                       int step_column, int resume_step, FILE **f, char **path);
+
+/** @brief Flush a log's rows; an error naming @p path if @p printed < 0
+ *         (fprintf's result) or the write failed. */
+int sp_output_log_done(FILE *f, const char *path, int printed);
 
 /** @brief The directory path (borrowed). */
 const char *sp_output_dir(sp_output out);

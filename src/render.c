@@ -291,6 +291,25 @@ static int sp_omega_outline(cairo_t *cr, const sp_mesh *m, const sp_frame *fr) {
   return SP_OK;
 }
 
+/** The outline of Omega (line width 1.5 @p lw) and the time in the white
+ *  strip above the picture: what every picture on the cells' frame has. */
+static int sp_outline_and_time(cairo_t *cr, const sp_mesh *m, const sp_frame *fr, double lw,
+                               double t, const char *what) {
+  SP_CALL(sp_omega_outline(cr, m, fr));
+  cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+  cairo_set_line_width(cr, 1.5 * lw);
+  cairo_stroke(cr);
+  char label[64];
+  snprintf(label, sizeof label, "t = %.2e", t);
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
+                         CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, fr->font);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_move_to(cr, fr->ox, 1.3 * fr->font);
+  cairo_show_text(cr, label);
+  return sp_cairo_check(cairo_status(cr), "drawing", what);
+}
+
 /** Everything drawn on an existing white RGB24 surface. */
 static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
                          const sp_mesh *m, const sp_layout *l,
@@ -353,24 +372,7 @@ static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
     cairo_stroke(cr);
   }
 
-  /* The outline of Omega. */
-  rc = sp_omega_outline(cr, m, fr);
-  if (rc == SP_OK) {
-    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-    cairo_set_line_width(cr, 1.5 * lw);
-    cairo_stroke(cr);
-
-    /* The time, in the white strip above the picture. */
-    char label[64];
-    snprintf(label, sizeof label, "t = %.2e", t);
-    cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
-                           CAIRO_FONT_WEIGHT_NORMAL);
-    cairo_set_font_size(cr, fr->font);
-    cairo_set_source_rgb(cr, 0, 0, 0);
-    cairo_move_to(cr, fr->ox, 1.3 * fr->font);
-    cairo_show_text(cr, label);
-    rc = sp_cairo_check(cairo_status(cr), "drawing", "cells");
-  }
+  rc = sp_outline_and_time(cr, m, fr, lw, t, "cells");
   cairo_destroy(cr);
   return rc;
 }
@@ -396,6 +398,79 @@ int sp_render_cells(const sp_mesh *mesh, const sp_layout *layout,
     cairo_paint(cr);
     cairo_destroy(cr);
     rc = sp_draw_cells(surf, &fr, mesh, layout, state, t);
+  }
+  if (rc == SP_OK) rc = sp_png_write(surf, path);
+  cairo_surface_destroy(surf);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Contact graph                                                            */
+/* ------------------------------------------------------------------------ */
+
+/** The graph on a white surface: the outline and the time, then the
+ *  edges, then the numbered discs on top. */
+static int sp_draw_contact_graph(cairo_t *cr, const sp_frame *fr, const sp_mesh *m,
+                                 int n_cells, const double *centre, int n_edges,
+                                 const int *edge, const double *length, double t) {
+  const double lw = fmax(1.0, fr->w / 700.0);
+  SP_CALL(sp_outline_and_time(cr, m, fr, lw, t, "contact graph"));
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  cairo_set_source_rgba(cr, 0.15, 0.3, 0.7, 0.8);
+  for (int j = 0; j < n_edges; ++j) {
+    double ax, ay, bx, by;
+    sp_frame_map(fr, centre[2 * edge[2 * j]], centre[2 * edge[2 * j] + 1], &ax, &ay);
+    sp_frame_map(fr, centre[2 * edge[2 * j + 1]], centre[2 * edge[2 * j + 1] + 1], &bx, &by);
+    /* a quarter of the contact's length at the picture's scale */
+    cairo_set_line_width(cr, fmax(1.0, 0.25 * length[j] * fr->s));
+    cairo_move_to(cr, ax, ay);
+    cairo_line_to(cr, bx, by);
+    cairo_stroke(cr);
+  }
+  const double radius = 0.8 * fr->font;
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  cairo_set_font_size(cr, 0.9 * fr->font);
+  for (int k = 0; k < n_cells; ++k) {
+    double x, y;
+    sp_frame_map(fr, centre[2 * k], centre[2 * k + 1], &x, &y);
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, x, y, radius, 0, 2 * sp_pi);
+    cairo_set_source_rgb(cr, 0.85, 0.15, 0.1);
+    cairo_fill_preserve(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, lw);
+    cairo_stroke(cr);
+    char label[16];
+    snprintf(label, sizeof label, "%d", k + 1); /* cells numbered from 1, as in cells.csv */
+    cairo_text_extents_t ext;
+    cairo_text_extents(cr, label, &ext);
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_move_to(cr, x - ext.width / 2 - ext.x_bearing, y - ext.height / 2 - ext.y_bearing);
+    cairo_show_text(cr, label);
+  }
+  return sp_cairo_check(cairo_status(cr), "drawing", "contact graph");
+}
+
+int sp_render_contact_graph(const sp_mesh *mesh, int n_cells, const double *centre,
+                            int n_edges, const int *edge, const double *length, double t,
+                            int width_px, const char *path) {
+  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
+           "render: pictures are not yet on a 3D mesh (issue 29)");
+  for (int j = 0; j < n_edges; ++j)
+    SP_CHECK(edge[2 * j] >= 0 && edge[2 * j] < n_cells && edge[2 * j + 1] >= 0 &&
+                 edge[2 * j + 1] < n_cells,
+             SP_ERR_INTERNAL, "render: contact %d joins cells %d and %d of %d", j, edge[2 * j],
+             edge[2 * j + 1], n_cells);
+  sp_frame fr;
+  SP_CALL(sp_frame_make(mesh, width_px, &fr));
+  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, fr.w, fr.h);
+  int rc = sp_cairo_check(cairo_surface_status(surf), "creating a surface", path);
+  if (rc == SP_OK) {
+    cairo_t *cr = cairo_create(surf);
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_paint(cr);
+    rc = sp_draw_contact_graph(cr, &fr, mesh, n_cells, centre, n_edges, edge, length, t);
+    cairo_destroy(cr);
   }
   if (rc == SP_OK) rc = sp_png_write(surf, path);
   cairo_surface_destroy(surf);

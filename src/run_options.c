@@ -80,6 +80,8 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
                               .shrink_always = scene->layout.shrink == SP_SHRINK_ALWAYS};
   opt->output = (sp_run_output){.every = out->every, .interval = out->interval,
                                 .pictures = out->pictures, .picture_width = out->picture_width,
+                                .contacts = out->contacts,
+                                .contact_threshold = out->contact_threshold,
                                 .timings = out->timings,
                                 .checkpoint_every = out->checkpoint_every,
                                 .checkpoint_seconds = out->checkpoint_seconds,

@@ -56,6 +56,8 @@ typedef struct {
   double interval;         /**< and at multiples of this time (0: off) */
   int pictures;            /**< PNG pictures */
   int picture_width;
+  int contacts;            /**< contacts.csv and contacts_<step>.png */
+  double contact_threshold; /**< contacts.h's threshold */
   int timings;             /**< energy.csv's wall-clock columns */
   int checkpoint_every;
   double checkpoint_seconds;

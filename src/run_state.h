@@ -24,6 +24,7 @@
 #include <mpi.h>
 #include <stddef.h>
 
+#include "contacts.h"
 #include "division.h"
 #include "dt_control.h"
 #include "layout.h"
@@ -66,6 +67,8 @@ typedef struct {
   void *on_step_user;
   sp_output_field *fields; /**< restarted: the checkpoint's fields.pvd list, */
   int n_fields;            /**< until the output is opened */
+  sp_contacts contacts;    /**< of the last energy row's state (output.contacts) */
+  sp_contacts_log contacts_log; /**< contacts.csv (rank 0) */
 } sp_monitor;
 
 /** What a checkpoint saves of the scene (may be NULL: none saved, and

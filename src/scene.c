@@ -452,6 +452,16 @@ static const sp_key sp_keys[] = {
              "write PNG pictures"),
     KEY_INT(SP_SEC_OUTPUT, "picture_width", output.picture_width, 800,
             AT_LEAST(64), AT_MOST(8192), "px", "picture width"),
+    KEY_BOOL(SP_SEC_OUTPUT, "contacts", output.contacts, 1, "-",
+             "write contacts.csv (every step, as cells.csv: each cell's volume, "
+             "diffuse and free surface, each pair in contact with its contact "
+             "area, a length in 2D) and, with pictures, contacts_<step>.png "
+             "(docs/model.md, \"Contacts\")"),
+    KEY_FLOAT(SP_SEC_OUTPUT, "contact_threshold", output.contact_threshold, 0.01,
+              AT_LEAST(0.0), AT_MOST(1.0), "-",
+              "two cells are in contact (a row of contacts.csv, an edge of the "
+              "contact graph) when their measured contact is at least this "
+              "fraction of the smaller of their two diffuse surfaces"),
     KEY_FLOAT(SP_SEC_OUTPUT, "interval", output.interval, 0.0, AT_LEAST(0.0),
               UNBOUNDED, "T",
               "also write fields and pictures at every multiple of this time "

@@ -146,6 +146,8 @@ typedef struct {
   int every;          /**< fields and pictures every this many steps */
   int pictures;       /**< 1: write PNG pictures */
   int picture_width;  /**< picture width in pixels */
+  int contacts;       /**< 1: write contacts.csv (and contacts_<step>.png) */
+  double contact_threshold; /**< in contact: A_kl >= this x min(S_k, S_l) */
   double interval;    /**< also write at multiples of this time (0: off);
                            steps land on those times */
   int timings;        /**< 1: energy.csv's wall-clock columns hold the

@@ -6,7 +6,8 @@
  *     every rank runs it together (MPI_COMM_WORLD) into mpi_LABEL_np<P>;
  *     rank 0 compares the CSVs: same steps, times and cell counts, the same
  *     divisions (step, parent, child), energies equal to 1e-9 relative (each
- *     part to 1e-9 of the total), cell masses to 1e-10 relative; with
+ *     part to 1e-9 of the total), cell masses to 1e-10 relative, the same
+ *     rows of contacts.csv with contacts and surfaces to 1e-9 relative; with
  *     P > 1, the .pvtu pieces cover the mesh once and hold the one-process
  *     fields (compare_fields; 2D scenes: a 3D run writes no fields yet).
  *
@@ -71,6 +72,36 @@ static void read_both(const char *ref, const char *par, const char *name, csv_ta
   CHECK(csv_read(path, p) == 0, "cannot read %s", path);
 }
 
+/** contacts.csv: the same rows (step, cell, other: the same pairs in
+ *  contact), contacts and surfaces equal to 1e-9 relative (each rank
+ *  integrates its elements, one reduction sums them: round-off apart, and
+ *  the states differ by Newton's tolerance). */
+static void compare_contacts(const char *ref, const char *par) {
+  csv_table r, p;
+  read_both(ref, par, "contacts.csv", &r, &p);
+  if (sp_test_failures) return;
+  CHECK(r.n_rows == p.n_rows, "contacts rows %d vs %d", r.n_rows, p.n_rows);
+  double worst = 0;
+  int pairs = 0;
+  static const char *values[] = {"contact", "surface", "free_surface"};
+  for (int i = 0; i < r.n_rows && i < p.n_rows; ++i) {
+    CHECK(at(&r, i, "step") == at(&p, i, "step") && at(&r, i, "cell") == at(&p, i, "cell") &&
+              at(&r, i, "other") == at(&p, i, "other"),
+          "contacts row %d: (step, cell, other) differ", i);
+    pairs += at(&r, i, "other") > 0;
+    for (int j = 0; j < 3; ++j) {
+      const double a = at(&r, i, values[j]), b = at(&p, i, values[j]);
+      /* (a free surface is a difference: relative to the surface) */
+      worst = fmax(worst, fabs(a - b) / fmax(fabs(at(&r, i, "surface")), fabs(a)));
+    }
+  }
+  printf("contacts.csv: %d rows (%d pair rows); largest relative difference %.2e\n", r.n_rows,
+         pairs, worst);
+  CHECK(worst <= 1e-9, "contacts differ by %.3g relative", worst);
+  free(r.v);
+  free(p.v);
+}
+
 static void compare_runs(const char *ref, const char *par, int divides) {
   csv_table er, ep, cr, cp, dr, dp;
   read_both(ref, par, "energy.csv", &er, &ep);
@@ -133,6 +164,7 @@ static void compare_runs(const char *ref, const char *par, int divides) {
   CHECK(dr.n_rows >= 1 || !divides, "the scene should divide");
   CHECK(worst_dm <= 1e-10, "division masses differ by %.3g relative", worst_dm);
   free(er.v); free(ep.v); free(cr.v); free(cp.v); free(dr.v); free(dp.v);
+  compare_contacts(ref, par);
 }
 
 /** Check the .pvtu output of an MPI run against the one-process .vtu files:

@@ -394,6 +394,40 @@ int main(void) {
     cairo_surface_destroy(s);
   }
 
+  /* ---- contact graph: the cells picture's frame, an edge a quarter of
+   * the contact's length wide, numbered red discs at the centres ---- */
+  {
+    const char *png = "test_output_tmp/contacts.png";
+    const int width = 480;
+    const double centre[4] = {0.5, 0.5, 2.5, 0.5}, length[1] = {0.4};
+    const int edge[2] = {0, 1};
+    CHECK_OK(sp_render_contact_graph(&mesh, 2, centre, 1, edge, length, 1e-2, width, png));
+    cairo_surface_t *s = cairo_image_surface_create_from_png(png);
+    CHECK(cairo_surface_status(s) == CAIRO_STATUS_SUCCESS, "cannot read %s", png);
+    if (cairo_surface_status(s) == CAIRO_STATUS_SUCCESS) {
+      int h = 0;
+      double px, py, qx, rgb[3];
+      CHECK_OK(sp_render_cells_pixel(&mesh, width, 1.5, 0.5, &px, &py, &h));
+      CHECK(cairo_image_surface_get_width(s) == width && cairo_image_surface_get_height(s) == h,
+            "contact graph %dx%d, the cells picture %dx%d", cairo_image_surface_get_width(s),
+            cairo_image_surface_get_height(s), width, h);
+      CHECK_OK(sp_render_cells_pixel(&mesh, width, 2.5, 0.5, &qx, NULL, NULL));
+      /* the edge's width at its middle: non-white pixels down the column */
+      int wide = 0;
+      for (int j = 0; j < h; ++j) {
+        png_pixel(s, (int)px, j, rgb);
+        const int blue = rgb[2] > 0.6 && rgb[0] < 0.5;
+        wide += blue && fabs(j - py) < 20;
+      }
+      const double expected = 0.25 * length[0] * (qx - px) / 1.0; /* pixels per unit: qx - px */
+      CHECK(fabs(wide - expected) <= 2, "edge %d px wide, expected %.1f", wide, expected);
+      png_pixel(s, (int)qx, (int)(py + 0.6 * fmax(10.0, width / 45.0)), rgb);
+      CHECK(rgb[0] > 0.7 && rgb[1] < 0.3, "cell 2's disc is not red: %.2f %.2f %.2f", rgb[0],
+            rgb[1], rgb[2]);
+    }
+    cairo_surface_destroy(s);
+  }
+
   /* ---- energy plots: normal, one point, constant ---- */
   {
     double t[50], e[50], marks[2] = {0.01, 0.03};

@@ -6,7 +6,7 @@
 #   checkpoint (--resume), and one stopped by SIGTERM to one of its
 #   processes (exit status 75, also through mpirun; a checkpoint at the
 #   step it stopped) and resumed, write energy.csv,
-#   cells.csv, divisions.csv and fields.pvd byte for byte as the
+#   cells.csv, divisions.csv, contacts.csv and fields.pvd byte for byte as the
 #   uninterrupted run;
 # - SIGKILLs at random times with a checkpoint every step (so some land
 #   inside a checkpoint write): the logs hold whole lines and the newest
@@ -76,14 +76,14 @@ wait_rows() {
 
 same_as_whole() { # DIR LABEL
   local f
-  for f in energy.csv cells.csv divisions.csv fields.pvd; do
+  for f in energy.csv cells.csv divisions.csv contacts.csv fields.pvd; do
     cmp -s "$work/whole/$f" "$1/$f" || fail "$2: $f differs from the uninterrupted run's"
   done
 }
 
 whole_lines() { # DIR LABEL: every log ends with a newline
   local f
-  for f in energy.csv cells.csv divisions.csv; do
+  for f in energy.csv cells.csv divisions.csv contacts.csv; do
     [ ! -s "$1/$f" ] || [ "$(tail -c 1 "$1/$f" | od -An -c | tr -d ' ')" = '\n' ] ||
       fail "$2: $f ends inside a line"
   done
@@ -152,7 +152,7 @@ done
 wait "$pid"
 run "$work/often" --set output.checkpoint_every=1 --resume "$work/often" ||
   fail "--resume after the SIGKILL rounds: status $?"
-for f in energy.csv cells.csv divisions.csv fields.pvd; do
+for f in energy.csv cells.csv divisions.csv contacts.csv fields.pvd; do
   cmp -s "$work/whole_often/$f" "$work/often/$f" || fail "SIGKILL rounds: $f differs"
 done
 

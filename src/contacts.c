@@ -1,0 +1,176 @@
+/* Contacts measured from the fields (contacts.h; docs/model.md, "Contacts"). */
+#include "contacts.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "agree.h"
+#include "error.h"
+#include "output.h"
+#include "q1.h"
+#include "render.h"
+
+/** Size @p c for @p n cells, every sum zero. */
+static int contacts_reset(sp_contacts *c, int n) {
+  const size_t pairs = (size_t)n * (size_t)(n > 0 ? n - 1 : 0) / 2;
+  if (n > c->cap || !c->surface) {
+    sp_contacts_clear(c);
+    SP_ALLOC(c->surface, n);
+    SP_ALLOC(c->overlap, pairs);
+    c->cap = n;
+  }
+  c->n_cells = n;
+  memset(c->surface, 0, sizeof(double) * (size_t)n);
+  memset(c->overlap, 0, sizeof(double) * (pairs ? pairs : 1));
+  return SP_OK;
+}
+
+int sp_contacts_integrate(const sp_mesh *mesh, const sp_layout *layout, const double *state,
+                          int first_node, int end_node, sp_contacts *out) {
+  SP_CHECK(layout->n_nodes == mesh->n_nodes, SP_ERR_INTERNAL,
+           "contacts: %d nodes in the layout, %d in the mesh", layout->n_nodes, mesh->n_nodes);
+  const int n = layout->n_cells, dim = mesh->dim, nen = mesh->nodes_per_elem;
+  const int nq = sp_q1_qpoints(dim);
+  SP_CALL(contacts_reset(out, n));
+  const sp_slots *t;
+  SP_CALL(sp_layout_slots(layout, mesh, &t));
+  double *grad; /* |grad c| of each slot of an element at one point */
+  SP_ALLOC(grad, (size_t)n + 1);
+  for (int e = 0; e < mesh->n_elems; ++e) {
+    const int first = mesh->elem[(size_t)nen * e];
+    const int64_t s0 = t->elem_start[e], s1 = t->elem_start[e + 1];
+    if (first < first_node || first >= end_node || s0 == s1) continue;
+    double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+    sp_mesh_elem_xy(mesh, e, xe);
+    for (int q = 0; q < nq; ++q) {
+      double N[SP_Q1_MAX_NODES], dN[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], x[SP_Q1_MAX_DIM], w;
+      sp_q1_point(dim, xe, q, N, dN, x, &w);
+      for (int64_t s = s0; s < s1; ++s) {
+        const int *pairs = t->slot_pair + (size_t)nen * s;
+        double g[SP_Q1_MAX_DIM] = {0, 0, 0};
+        for (int b = 0; b < nen; ++b)
+          for (int i = 0; i < dim; ++i) g[i] += dN[b][i] * state[2 * pairs[b]];
+        const double norm = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        grad[s - s0] = norm;
+        out->surface[t->slot_cell[s]] += w * norm;
+      }
+      /* the pairs living on the element (slots by increasing cell, so
+       * k < l): the interface density they share, the smaller of the two */
+      for (int64_t s = s0; s < s1; ++s)
+        for (int64_t r = s + 1; r < s1; ++r)
+          out->overlap[sp_contacts_pair(n, t->slot_cell[s], t->slot_cell[r])] +=
+              w * fmin(grad[s - s0], grad[r - s0]);
+    }
+  }
+  free(grad);
+  return SP_OK;
+}
+
+int sp_contacts_reduce(MPI_Comm comm, sp_contacts *c) {
+  const int n = c->n_cells;
+  const size_t pairs = (size_t)n * (size_t)(n > 0 ? n - 1 : 0) / 2;
+  SP_CHECK(n + pairs <= (size_t)INT_MAX, SP_ERR_INTERNAL, "contacts: %d cells", n);
+  double *sums;
+  SP_ALLOC(sums, (size_t)n + pairs);
+  memcpy(sums, c->surface, sizeof(double) * (size_t)n);
+  memcpy(sums + n, c->overlap, sizeof(double) * pairs);
+  const int rc = MPI_Allreduce(MPI_IN_PLACE, sums, (int)((size_t)n + pairs), MPI_DOUBLE,
+                               MPI_SUM, comm);
+  if (rc == MPI_SUCCESS) {
+    memcpy(c->surface, sums, sizeof(double) * (size_t)n);
+    memcpy(c->overlap, sums + n, sizeof(double) * pairs);
+  }
+  free(sums);
+  return rc == MPI_SUCCESS ? SP_OK : sp_mpi_error(rc, "MPI_Allreduce (contacts)");
+}
+
+int sp_contacts_touch(const sp_contacts *c, int k, int l, double threshold) {
+  if (k == l) return 0;
+  if (k > l) {
+    const int swap = k;
+    k = l;
+    l = swap;
+  }
+  const double a = c->overlap[sp_contacts_pair(c->n_cells, k, l)];
+  return a > 0 && a >= threshold * fmin(c->surface[k], c->surface[l]);
+}
+
+void sp_contacts_of_cell(const sp_contacts *c, int k, double threshold, double *contact,
+                         double *free_surface) {
+  double sum = 0;
+  for (int l = 0; l < c->n_cells; ++l)
+    if (sp_contacts_touch(c, k, l, threshold))
+      sum += c->overlap[k < l ? sp_contacts_pair(c->n_cells, k, l)
+                              : sp_contacts_pair(c->n_cells, l, k)];
+  *contact = sum;
+  *free_surface = c->surface[k] - sum;
+}
+
+void sp_contacts_clear(sp_contacts *c) {
+  free(c->surface);
+  free(c->overlap);
+  *c = (sp_contacts){0};
+}
+
+int sp_contacts_log_open(const char *dir, int resume_step, sp_contacts_log *log) {
+  return sp_output_log_open(dir, "contacts.csv", SP_CONTACTS_HEADER, 0, resume_step, &log->f,
+                            &log->path);
+}
+
+int sp_contacts_log_write(sp_contacts_log *log, int step, double t, const sp_contacts *c,
+                          const sp_cell_obs *obs, double threshold) {
+  const int n = c->n_cells;
+  int printed = 0;
+  for (int k = 0; k < n && printed >= 0; ++k) {
+    double contact, free_surface;
+    sp_contacts_of_cell(c, k, threshold, &contact, &free_surface);
+    printed = fprintf(log->f, "%d,%.17g,%d,0,%.17g,%.17g,%.17g,%.17g\n", step, t, k + 1,
+                      contact, obs[k].area, c->surface[k], free_surface);
+  }
+  for (int k = 0; k < n && printed >= 0; ++k)
+    for (int l = k + 1; l < n && printed >= 0; ++l)
+      if (sp_contacts_touch(c, k, l, threshold))
+        printed = fprintf(log->f, "%d,%.17g,%d,%d,%.17g,,,\n", step, t, k + 1, l + 1,
+                          c->overlap[sp_contacts_pair(n, k, l)]);
+  return sp_output_log_done(log->f, log->path, printed);
+}
+
+int sp_contacts_log_close(sp_contacts_log *log) {
+  int rc = SP_OK;
+  if (log->f && fclose(log->f) != 0)
+    rc = sp_error_set(SP_ERR_IO, "cannot close '%s'", log->path);
+  free(log->path);
+  *log = (sp_contacts_log){0};
+  return rc;
+}
+
+int sp_contacts_picture(const sp_contacts *c, const sp_mesh *mesh, const sp_cell_obs *obs,
+                        double threshold, double t, int width_px, const char *path) {
+  const int n = c->n_cells;
+  const size_t pairs = (size_t)n * (size_t)(n > 0 ? n - 1 : 0) / 2;
+  double *centre, *length;
+  int *edge;
+  SP_ALLOC(centre, 2 * (size_t)n);
+  int rc = SP_OK;
+  length = malloc(sizeof(double) * (pairs ? pairs : 1));
+  edge = malloc(sizeof(int) * 2 * (pairs ? pairs : 1));
+  if (!length || !edge) rc = sp_error_set(SP_ERR_MEMORY, "out of memory for the contact graph");
+  int n_edges = 0;
+  for (int k = 0; k < n && rc == SP_OK; ++k) {
+    centre[2 * k] = obs[k].xc;
+    centre[2 * k + 1] = obs[k].yc;
+    for (int l = k + 1; l < n; ++l)
+      if (sp_contacts_touch(c, k, l, threshold)) {
+        edge[2 * n_edges] = k;
+        edge[2 * n_edges + 1] = l;
+        length[n_edges++] = c->overlap[sp_contacts_pair(n, k, l)];
+      }
+  }
+  if (rc == SP_OK)
+    rc = sp_render_contact_graph(mesh, n, centre, n_edges, edge, length, t, width_px, path);
+  free(centre);
+  free(length);
+  free(edge);
+  return rc;
+}
