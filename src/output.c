@@ -268,9 +268,11 @@ static const struct {
     {"divisions.csv",
      "t,step,parent,child,axis_angle,parent_mass_before,parent_mass_after,child_mass_after", 1}};
 
-/** cells.csv's header on a 3D mesh: the centre with z, the volume inside
- *  the membrane; no moments yet (issue 29). */
-static const char sp_cells_header_3d[] = "step,t,cell,mass,xc,yc,zc,core_mass,volume";
+/** cells.csv's header on a 3D mesh: the centre with z, the three principal
+ *  moments, the long axis (the unit eigenvector of the smallest moment I3,
+ *  the normal of a division's cut), the volume inside the membrane. */
+static const char sp_cells_header_3d[] =
+    "step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,long_z,core_mass,volume";
 
 /** Open @p dir's logs for a mesh of dimension @p dim: new ones
  *  (@p resume_step < 0), or the existing ones cut back to the rows of steps
@@ -337,9 +339,12 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
   int n = 0;
   if (out->dim == 3) {
     for (int k = 0; k < n_cells && n >= 0; ++k)
-      n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", step, t,
-                  k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].zc, obs[k].mass_core,
-                  obs[k].area);
+      n = fprintf(out->cells,
+                  "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
+                  "%.17g,%.17g\n",
+                  step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].zc, obs[k].I1,
+                  obs[k].I2, obs[k].I3, obs[k].v3[0], obs[k].v3[1], obs[k].v3[2],
+                  obs[k].mass_core, obs[k].area);
     return sp_log_done(out->cells, out->cells_path, n);
   }
   for (int k = 0; k < n_cells && n >= 0; ++k)

@@ -23,7 +23,8 @@ typedef struct sp_output_s *sp_output;
 int sp_output_open(const char *dir, sp_output *out);
 
 /** @brief sp_output_open for a mesh of dimension @p dim (2 or 3): on a 3D
- *         mesh cells.csv is step,t,cell,mass,xc,yc,zc,core_mass,volume. */
+ *         mesh cells.csv is step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,
+ *         long_z,core_mass,volume (docs/3d.md). */
 int sp_output_open_dim(const char *dir, int dim, sp_output *out);
 
 /** One fields file of fields.pvd: fields_<step>.vtu, or .pvtu of pieces. */
