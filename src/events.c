@@ -158,6 +158,8 @@ static int divide_cell(sp_run *run, int parent, sp_division_record *record) {
                                  .parent_mass = parent_obs.mass,
                                  .mass_a = cells->obs[parent].mass,
                                  .mass_b = cells->obs[child].mass};
+  double centre[3];
+  sp_division_plane(&parent_obs, run->mesh->dim, centre, record->axis);
   return SP_OK;
 }
 

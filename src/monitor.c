@@ -207,7 +207,7 @@ static int record_divisions(sp_run *run, const sp_step_events *ev) {
     SP_CALL(append(&mon->division_t, &mon->n_divisions, run->t));
     if (run->rank == 0)
       SP_CALL(sp_output_division(mon->output, run->t, run->step, d->parent, d->child, d->angle,
-                                 d->parent_mass, d->mass_a, d->mass_b));
+                                 d->axis, d->parent_mass, d->mass_a, d->mass_b));
   }
   return SP_OK;
 }

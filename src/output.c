@@ -274,6 +274,12 @@ static const struct {
 static const char sp_cells_header_3d[] =
     "step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,long_z,core_mass,volume";
 
+/** divisions.csv's header on a 3D mesh: the parent's long axis (the cut
+ *  plane's normal) instead of the 2D line's angle. */
+static const char sp_divisions_header_3d[] =
+    "t,step,parent,child,long_x,long_y,long_z,parent_mass_before,parent_mass_after,"
+    "child_mass_after";
+
 /** Open @p dir's logs for a mesh of dimension @p dim: new ones
  *  (@p resume_step < 0), or the existing ones cut back to the rows of steps
  *  <= @p resume_step and appended to. */
@@ -296,7 +302,10 @@ static int output_open(const char *dir, int dim, int resume_step, sp_output *out
   for (int i = 0; i < 3 && rc == SP_OK; ++i) {
     int exists = 0;
     if (resume_step >= 0) rc = sp_log_cut(paths[i], sp_logs[i].step_column, resume_step, &exists);
-    const char *header = i == 1 && dim == 3 ? sp_cells_header_3d : sp_logs[i].header;
+    const char *header = dim != 3 ? sp_logs[i].header
+                         : i == 1     ? sp_cells_header_3d
+                         : i == 2     ? sp_divisions_header_3d
+                                      : sp_logs[i].header;
     if (rc == SP_OK) rc = sp_log_open(paths[i], exists ? NULL : header, files[i]);
   }
   if (rc != SP_OK) {
@@ -355,8 +364,15 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
 }
 
 int sp_output_division(sp_output out, double t, int step, int parent,
-                       int child, double axis_angle, double mass_before,
-                       double parent_mass_after, double child_mass_after) {
+                       int child, double axis_angle, const double long_axis[3],
+                       double mass_before, double parent_mass_after,
+                       double child_mass_after) {
+  if (out->dim == 3) {
+    const int n = fprintf(out->divisions, "%.17g,%d,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                          t, step, parent + 1, child + 1, long_axis[0], long_axis[1],
+                          long_axis[2], mass_before, parent_mass_after, child_mass_after);
+    return sp_log_done(out->divisions, out->divisions_path, n);
+  }
   int n = fprintf(out->divisions, "%.17g,%d,%d,%d,%.17g,%.17g,%.17g,%.17g\n",
                   t, step, parent + 1, child + 1, axis_angle, mass_before,
                   parent_mass_after, child_mass_after);

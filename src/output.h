@@ -128,10 +128,13 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
 
 /** @brief Append one row to divisions.csv: t,step,parent,child,axis_angle,
  *         parent_mass_before,parent_mass_after,child_mass_after (cells
- *         numbered from 1; the angle is the division line's, from x). */
+ *         numbered from 1; the angle is the division line's, from x); on a
+ *         3D mesh the angle's column is three, long_x,long_y,long_z: the
+ *         parent's long axis @p long_axis, the cut plane's unit normal. */
 int sp_output_division(sp_output out, double t, int step, int parent,
-                       int child, double axis_angle, double mass_before,
-                       double parent_mass_after, double child_mass_after);
+                       int child, double axis_angle, const double long_axis[3],
+                       double mass_before, double parent_mass_after,
+                       double child_mass_after);
 
 /** @brief The directory path (borrowed). */
 const char *sp_output_dir(sp_output out);

@@ -1372,13 +1372,11 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
 #define SP_NOT_YET_3D "not yet in 3D (mesh.type box; issue 29)"
 
 /** What a scene on a 3D mesh cannot ask for yet, each refused naming its
- *  key, rather than run wrong: divisions, the shape term, local supports,
- *  pictures, checkpoints and initial fields from files (the VTU fields are
- *  not written in 3D: no key asks for them). */
+ *  key, rather than run wrong: the shape term, local supports, pictures,
+ *  checkpoints and initial fields from files (the VTU fields are not
+ *  written in 3D: no key asks for them). */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
-  SP_CHECK(scene->division.criterion == SP_DIVIDE_NONE, SP_ERR_INPUT,
-           "%s: division.criterion: divisions are " SP_NOT_YET_3D ": expected none", file);
   SP_CHECK(scene->shape.delta1 == 0, SP_ERR_INPUT,
            "%s: shape.delta1: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
            scene->shape.delta1);
@@ -1392,6 +1390,16 @@ static int check_3d(const sp_scene *scene, const char *file) {
            "%s: layout.support: local supports are " SP_NOT_YET_3D
            ": expected full (auto is local beyond 4 cells; the scene has %d)",
            file, scene->n_cells);
+  /* ... or when divisions can make more than 4 (N_max from the volume is
+   * only known with the mesh: then full must be asked for) */
+  const int max_cells = scene->division.max_cells;
+  SP_CHECK(scene->layout.support == SP_SUPPORT_FULL ||
+               scene->division.criterion == SP_DIVIDE_NONE || (max_cells >= 1 && max_cells <= 4),
+           SP_ERR_INPUT,
+           "%s: layout.support: local supports are " SP_NOT_YET_3D
+           ": expected full for a scene with divisions (auto is local when divisions can make "
+           "more than 4 cells; division.max_cells = %d, 0: from the volume)",
+           file, max_cells);
   SP_CHECK(!scene->output.pictures, SP_ERR_INPUT,
            "%s: output.pictures: pictures are " SP_NOT_YET_3D ": expected false", file);
   SP_CHECK(scene->output.checkpoint_every == 0, SP_ERR_INPUT,
