@@ -29,6 +29,7 @@
 #include "cells.h"
 #include "check.h"
 #include "division.h"
+#include "division_fixtures.h"
 #include "error.h"
 #include "fixtures.h"
 #include "layout.h"
@@ -211,40 +212,15 @@ static void test_equal_mass_plane(void) {
         const double centre[3] = {0.2517, 0.2483, 0.2509}, semi[3] = {0.14, 0.08, 0.07};
         set_ellipsoid(mesh, layout, state, 0, centre, axes, semi, width / semi[2]);
       }
-      sp_cell_obs before, after[2];
-      CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, &before));
-      double largest_share = 0;
-      for (int i = 0; i < mesh->n_nodes; ++i)
-        largest_share = fmax(largest_share, w[i] * state[2 * sp_layout_pair(layout, 0, i)]);
-      double unequal[2], offset = 0;
-      for (int balanced = 0; balanced <= 1; ++balanced) {
-        if (balanced)
-          CHECK_OK(sp_division_balance_offset(mesh, layout, state, 0, &before, smooth, width,
-                                              &offset));
-        CHECK_OK(sp_division_split(mesh, layout, state, 0, &before, smooth, width,
-                                   balanced ? offset : 0.0, new_layout, new_state, 1));
-        CHECK_OK(sp_cells_observe(mesh, new_layout, new_state, WEIGHT_THRESHOLD, after));
-        const double total = after[0].mass + after[1].mass;
-        CHECK(fabs(total - before.mass) <= 1e-12 * before.mass,
-              "egg %d smooth %d balanced %d: mass %.17g -> %.17g", egg, smooth, balanced,
-              before.mass, total);
-        unequal[balanced] = fabs(after[0].mass - after[1].mass) / (0.5 * total);
+      double largest_share = 0, mass = 0;
+      for (int i = 0; i < mesh->n_nodes; ++i) {
+        const double share = w[i] * state[2 * sp_layout_pair(layout, 0, i)];
+        largest_share = fmax(largest_share, share);
+        mass += share;
       }
       /* the sharp cut's child mass jumps by one node's w_i c_i at a time */
-      const double allowed = smooth ? 1e-10 : largest_share / (0.5 * before.mass);
-      printf("  %-16s | %-6s | %+9.2e | %.2e | %.2e (%.1e)\n", egg ? "egg" : "ellipsoid",
-             smooth ? "smooth" : "sharp", offset, unequal[0], unequal[1], allowed);
-      CHECK(unequal[1] <= allowed, "egg %d smooth %d: equal-mass daughters differ by %.3g "
-            "(allowed %.1g)", egg, smooth, unequal[1], allowed);
-      if (egg) {
-        CHECK(unequal[0] >= 0.03, "egg smooth %d: the centre plane splits it %.3g: the test "
-              "needs an unequal parent", smooth, unequal[0]);
-        CHECK(fabs(offset) > 0.1 * mesh->h && fabs(offset) < 0.1, "egg smooth %d: offset %g",
-              smooth, offset);
-      } else if (smooth) {
-        CHECK(fabs(offset) <= 1e-3 * mesh->h, "symmetric ellipsoid: the plane moved by %g",
-              offset);
-      }
+      check_equal_mass_cut(mesh, layout, new_layout, state, new_state, egg, smooth, width,
+                           WEIGHT_THRESHOLD, 1e-12, smooth ? 1e-10 : largest_share / (0.5 * mass));
     }
   free(w);
   free(state);
