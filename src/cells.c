@@ -303,11 +303,37 @@ int sp_cells_fill(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *l
   return SP_OK;
 }
 
-/** The scene's cell k: a disk (2D) or a sphere (3D) with the
- *  tanh profile of width d, or sharp. */
+/** The signed distance from an ellipse (ellipsoid) with semi-axes s along
+ *  the coordinate axes centred at c, to first order: (rho - 1) / |grad rho|
+ *  with rho^2 = sum_j ((x_j - c_j) / s_j)^2, exact on the boundary's normals
+ *  near it and for a sphere; -min s at the centre, where rho has no
+ *  gradient. */
+static double ellipsoid_distance(const double *x, const double *c, const double *s, int dim) {
+  double rho2 = 0, grad2 = 0, smallest = s[0];
+  for (int j = 0; j < dim; ++j) {
+    const double u = (x[j] - c[j]) / s[j];
+    rho2 += u * u;
+    grad2 += (u / s[j]) * (u / s[j]);
+    smallest = fmin(smallest, s[j]);
+  }
+  if (grad2 == 0) return -smallest;
+  const double rho = sqrt(rho2);
+  return (rho - 1.0) * rho / sqrt(grad2); /* |grad rho| = sqrt(grad2) / rho */
+}
+
+/** The scene's cell k: a disk (2D) or a sphere (3D), or with semi-axes an
+ *  ellipse (ellipsoid), with the tanh profile of width d, or sharp. */
 static double disk_profile(int k, const double *x, int dim, void *ctx) {
   const sp_scene *scene = ctx;
   const sp_scene_cell *cell = &scene->cells[k];
+  if (sp_scene_cell_is_ellipsoid(cell)) {
+    const double c[3] = {cell->x, cell->y, cell->z};
+    double s[3] = {1, 1, 1}; /* (z unused in 2D) */
+    for (int j = 0; j < dim; ++j) s[j] = sp_scene_cell_semi_axis(cell, j);
+    const double distance = ellipsoid_distance(x, c, s, dim);
+    if (cell->profile == SP_PROFILE_SHARP) return distance <= 0 ? 1.0 : 0.0;
+    return sp_cells_profile(distance, sp_scene_interface_width(scene));
+  }
   const double r = dim == 2 ? hypot(x[0] - cell->x, x[1] - cell->y)
                             : sqrt((x[0] - cell->x) * (x[0] - cell->x) +
                                    (x[1] - cell->y) * (x[1] - cell->y) +

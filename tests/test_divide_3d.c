@@ -1,12 +1,15 @@
 /* Divisions through the run in 3D (issue 29 phase 2), as `softpack run`
  * makes them (scene, box of hexahedra, full supports, MUMPS):
- *  - tests/scenes/divide_3d.yaml: one cell at constant volume (s = 0,
- *    backward Euler, fixed dt) divides once by age at t = 0.001: the split
- *    gives the parent's mass to its daughters (1e-12 relative, divisions.csv
- *    and cells.csv), every cell's mass is conserved to 1e-12 relative at
- *    every other step, the cut's normal is a unit vector and the
- *    daughters' centres lie apart along it (within 0.05 rad: hemispheres of
- *    a sphere on a coarse mesh, h = 0.3 r);
+ *  - tests/scenes/divide_3d.yaml: one ellipsoidal cell (semi-axes 0.17,
+ *    0.11, 0.11, long along x) at constant volume (s = 0, backward Euler,
+ *    fixed dt) divides once by age at t = 0.001 with the smoothed cut on
+ *    the equal-mass plane: the split gives the parent's mass to its
+ *    daughters (1e-12 relative, divisions.csv and cells.csv) in equal
+ *    halves (1e-10, test_division_3d's bound), every cell's mass is
+ *    conserved to 1e-12 relative at every other step, the cut's normal is
+ *    a unit vector along x (within 0.01 rad: the background noise of
+ *    +-0.01 tilts the moments) and the daughters' centres lie apart along
+ *    it (within 0.01 rad);
  *  - tests/scenes/grow_divide_3d.yaml: with the source on (s = 5e2,
  *    adaptive steps, backward Euler), one cell grows, divides once by mass
  *    (N_max = 2) and the run reaches t_end: before the division its mass
@@ -43,9 +46,10 @@ static sp_run_summary run(const char *scene_file, const char *out) {
   return sum;
 }
 
-/** The one row of @p out's divisions.csv: its step, the parent's long axis;
+/** The one row of @p out's divisions.csv: its step, the parent's long axis,
+ *  |m_parent / m_child - 1| after the split (@p halves, if not NULL);
  *  checks the header, |axis| = 1 and the split's mass balance. */
-static int read_division(const char *out, double axis[3]) {
+static int read_division(const char *out, double axis[3], double *halves) {
   char path[512];
   snprintf(path, sizeof path, "%s/divisions.csv", out);
   csv_table d;
@@ -58,6 +62,7 @@ static int read_division(const char *out, double axis[3]) {
   const double before = at(&d, 0, "parent_mass_before");
   const double after = at(&d, 0, "parent_mass_after") + at(&d, 0, "child_mass_after");
   const int step = (int)at(&d, 0, "step");
+  if (halves) *halves = fabs(at(&d, 0, "parent_mass_after") / at(&d, 0, "child_mass_after") - 1);
   printf("  division at step %d: long axis (%.4f, %.4f, %.4f), parent %.17g -> %.17g + %.17g\n",
          step, axis[0], axis[1], axis[2], before, at(&d, 0, "parent_mass_after"),
          at(&d, 0, "child_mass_after"));
@@ -99,8 +104,14 @@ static void test_constant_volume(void) {
   const sp_run_summary sum = run(SP_SOURCE_DIR "/tests/scenes/divide_3d.yaml", out);
   CHECK(sum.divisions == 1 && sum.n_cells == 2, "%d divisions, %d cells", sum.divisions,
         sum.n_cells);
-  double axis[3];
-  const int at_step = read_division(out, axis);
+  double axis[3], halves;
+  const int at_step = read_division(out, axis, &halves);
+  const double off_x = acos(fmin(1.0, fabs(axis[0])));
+  printf("  the cut's normal at %.3g rad from x; daughters' masses differ by %.3g\n", off_x,
+         halves);
+  CHECK(off_x <= 0.01, "the cut's normal (%g, %g, %g) is %.3g rad from x", axis[0], axis[1],
+        axis[2], off_x);
+  CHECK(halves <= 1e-10, "equal-mass plane: the daughters differ by %.3g", halves);
   enum { CAP = 64 };
   double mass[CAP][MAX_CELLS], x[CAP][MAX_CELLS], y[CAP][MAX_CELLS], z[CAP][MAX_CELLS];
   const int rows = read_cells(out, "mass", mass, CAP);
@@ -136,7 +147,7 @@ static void test_constant_volume(void) {
     const double cosine = (d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2]) / len;
     printf("  daughters' centres %.4f apart, at %.3g rad from the long axis\n", len,
            acos(fmin(1.0, cosine)));
-    CHECK(cosine >= cos(0.05), "the daughters' centres apart at %.3g rad from the axis",
+    CHECK(cosine >= cos(0.01), "the daughters' centres apart at %.3g rad from the axis",
           acos(fmin(1.0, cosine)));
   }
 }
@@ -147,7 +158,7 @@ static void test_growth(void) {
   CHECK(sum.divisions == 1 && sum.n_cells == 2, "%d divisions, %d cells", sum.divisions,
         sum.n_cells);
   double axis[3];
-  const int at_step = read_division(out, axis);
+  const int at_step = read_division(out, axis, NULL);
   enum { CAP = 400 };
   static double mass[CAP][MAX_CELLS], core[CAP][MAX_CELLS];
   const int rows = read_cells(out, "mass", mass, CAP);
