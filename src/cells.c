@@ -36,6 +36,14 @@ void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
  *  round-off in 4 to 6, so this bound is never the one that stops. */
 #define SP_JACOBI_MAX_SWEEPS 50
 
+/** The off-diagonal part counts as zero below this fraction of the
+ *  diagonal's size (under half an ulp of its largest entry). */
+#define SP_JACOBI_OFF_DIAGONAL 1e-17
+
+/** Beyond this |theta| the rotation's tangent is 1 / (2 theta) (theta^2
+ *  would overflow; the two agree to round-off long before). */
+#define SP_JACOBI_THETA_LARGE 1e150
+
 /** A generic direction, r = (-sin 0.2 cos 0.5, cos 0.2 cos 0.5, sin 0.5):
  *  sp_cells_principal3 makes every eigenvector's r component >= 0. Its
  *  plane r . v = 0, where round-off can flip a sign, contains no
@@ -56,14 +64,14 @@ void sp_cells_principal3(const double tensor[3][3], double moments[3], double v[
   for (int sweep = 0; sweep < SP_JACOBI_MAX_SWEEPS; ++sweep) {
     const double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
     const double diag = fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2]);
-    if (off == 0.0 || off <= 1e-17 * diag) break; /* below a diagonal's ulp */
+    if (off == 0.0 || off <= SP_JACOBI_OFF_DIAGONAL * diag) break;
     for (int p = 0; p < 2; ++p)
       for (int q = p + 1; q < 3; ++q) {
         if (a[p][q] == 0.0) continue;
         /* the rotation in the (p, q) plane that zeroes a[p][q]: t = tan of
          * its angle, the smaller root of t^2 + 2 theta t - 1 = 0 */
         const double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-        const double t = fabs(theta) > 1e150 ? 0.5 / theta
+        const double t = fabs(theta) > SP_JACOBI_THETA_LARGE ? 0.5 / theta
                                              : copysign(1.0, theta) /
                                                    (fabs(theta) + sqrt(theta * theta + 1.0));
         const double c = 1.0 / sqrt(t * t + 1.0), s = t * c;

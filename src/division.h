@@ -161,8 +161,9 @@ double sp_division_crossing_fraction(const sp_division_params *params,
 double sp_division_child_share(double sd, int smooth, double width, double on_line);
 
 /**
- * @brief The division line of a cell: through its centre of mass along v1,
- *        the unit eigenvector of the LARGEST principal moment I1 (MODEL.md).
+ * @brief The division line of a cell in 2D: through its centre of mass
+ *        along v1, the unit eigenvector of the LARGEST principal moment I1
+ *        (MODEL.md); sp_division_plane gives the cut in either dimension.
  *
  * For an ellipse elongated along x, I1 = int c Xb1^2 is the larger moment and
  * v1 is the y axis: the cell is cut across its length.

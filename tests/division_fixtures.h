@@ -1,5 +1,6 @@
-/* The equal-mass line (2D) or plane (3D) check shared by test_division and
- * test_division_3d (division.line: equal_mass). */
+/* What test_division and test_division_3d share: a cell's mass summed in
+ * long double, and the equal-mass line (2D) or plane (3D) check
+ * (division.line: equal_mass). */
 #ifndef SP_TEST_DIVISION_FIXTURES_H
 #define SP_TEST_DIVISION_FIXTURES_H
 #include <math.h>
@@ -11,6 +12,20 @@
 #include "error.h"
 #include "layout.h"
 #include "mesh.h"
+
+/** Mass of cell k = sum_i w_i c_k(i) (w_i the node weights), summed in
+ *  long double: the same integral as sp_cells_observe's, but with a
+ *  round-off far below the ~1e-13 of a plain double sum over 1e5
+ *  quadrature points, so that it can show the split's own conservation. */
+static inline double cell_mass(const sp_layout *layout, const double *state, const double *w,
+                               int k) {
+  long double sum = 0;
+  for (int i = 0; i < layout->n_nodes; ++i) {
+    const int p = sp_layout_pair(layout, k, i);
+    if (p >= 0) sum += (long double)w[i] * state[2 * p];
+  }
+  return (double)sum;
+}
 
 /**
  * Split cell 0 of @p state (one cell on @p layout; @p new_layout has two)

@@ -144,6 +144,19 @@ static inline void set_ellipse(const sp_mesh *mesh, const sp_layout *layout, dou
   }
 }
 
+static inline double dot3(const double *a, const double *b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline double norm3(const double *a) { return sqrt(dot3(a, a)); }
+
+/** The angle between two lines (undirected) in 3D, in [0, pi/2]. */
+static inline double line_angle3(const double *a, const double *b) {
+  const double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                       a[0] * b[1] - a[1] * b[0]};
+  return atan2(norm3(c), fabs(dot3(a, b)));
+}
+
 /** The 3D twin of set_ellipse on a 3D mesh: c_k = 1 / (1 + exp((rho - 1) /
  *  eps)), rho^2 = sum_j (u_j / semi[j])^2 with u_j = axes[j] . (X - centre)
  *  (axes: three orthonormal rows), no background; mu_k = 0. */

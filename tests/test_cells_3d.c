@@ -37,17 +37,6 @@
 /** The interface width of the paper's parameters, sqrt(1e-3 / 8). */
 static double interface_width(void) { return sqrt(1e-3 / 8.0); }
 
-static double dot3(const double *a, const double *b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-/** The angle between two lines (undirected) in 3D, in [0, pi/2]. */
-static double line_angle3(const double *a, const double *b) {
-  const double cx = a[1] * b[2] - a[2] * b[1], cy = a[2] * b[0] - a[0] * b[2],
-               cz = a[0] * b[1] - a[1] * b[0];
-  return atan2(sqrt(cx * cx + cy * cy + cz * cz), fabs(dot3(a, b)));
-}
-
 /** |v_i . v_j - delta_ij| over the three eigenvectors of @p o. */
 static double orthonormality(const sp_cell_obs *o) {
   const double *v[3] = {o->v1, o->v2, o->v3};

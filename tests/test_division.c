@@ -108,19 +108,6 @@ static double *nodal_weights(const sp_mesh *mesh) {
   return w;
 }
 
-/** Mass of cell k = sum_i w_i c_k(i), summed in long double: the same
- *  integral as sp_cells_observe's, but with a round-off far below the
- *  ~1e-13 of a plain double sum over 1e5 quadrature points, so that it can
- *  show the split's own conservation. */
-static double cell_mass(const sp_layout *layout, const double *state, const double *w, int k) {
-  long double sum = 0;
-  for (int i = 0; i < layout->n_nodes; ++i) {
-    const int p = sp_layout_pair(layout, k, i);
-    if (p >= 0) sum += (long double)w[i] * state[2 * p];
-  }
-  return (double)sum;
-}
-
 /** Signed distance of node i from the axis of obs, with n = v2 (the side
  *  the child takes is sd > 0). */
 static double signed_distance(const sp_mesh *mesh, const sp_cell_obs *obs, int i) {

@@ -40,30 +40,6 @@
 
 static double interface_width(void) { return sqrt(1e-3 / 8.0); }
 
-static double dot3(const double *a, const double *b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static double norm3(const double *a) { return sqrt(dot3(a, a)); }
-
-/** The angle between two lines (undirected), in [0, pi/2]. */
-static double line_angle3(const double *a, const double *b) {
-  const double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                       a[0] * b[1] - a[1] * b[0]};
-  return atan2(norm3(c), fabs(dot3(a, b)));
-}
-
-/** Cell k's mass sum_i w_i c_k(i) in long double (round-off far below the
- *  split's own conservation). */
-static double cell_mass(const sp_layout *layout, const double *state, const double *w, int k) {
-  long double sum = 0;
-  for (int i = 0; i < layout->n_nodes; ++i) {
-    const int p = sp_layout_pair(layout, k, i);
-    if (p >= 0) sum += (long double)w[i] * state[2 * p];
-  }
-  return (double)sum;
-}
-
 /** How far apart the centres of the two halves of a tanh ellipsoid (cut
  *  through its centre normal to the semi-axis @p a, profile width @p eps in
  *  rho units, weight where c >= WEIGHT_THRESHOLD) lie: 2 a E[u] with
