@@ -25,15 +25,22 @@ typedef struct {
                          cell without its background (division, source) */
   double xc, yc;    /**< centre of mass int c X / int c */
   double zc;        /**< its z on a 3D mesh (0 in 2D) */
-  double Ixx, Iyy, Ixy; /**< inertia tensor [[Ixx, Ixy],[Ixy, Iyy]] about
-                             the centre: Ixx = int c Xb2^2, Iyy = int c Xb1^2,
-                             Ixy = -int c Xb1 Xb2; 2D only (on a 3D mesh
-                             this and the moments, eigenvectors and angle
-                             below are zero, v1 and v2 the x and y axes,
-                             until issue 29's 3x3 tensor) */
-  double I1, I2;    /**< principal moments, I1 >= I2 */
-  double v1[2], v2[2]; /**< unit eigenvectors of I1 and I2 */
-  double angle;     /**< angle of v1 from the x axis, in (-pi/2, pi/2] */
+  double Ixx, Iyy, Ixy; /**< inertia tensor about the centre, Xb = X - Xc:
+                             2D [[Ixx, Ixy],[Ixy, Iyy]] with Ixx = int c Xb2^2,
+                             Iyy = int c Xb1^2, Ixy = -int c Xb1 Xb2
+                             (MODEL.md); 3D the rigid body's tensor
+                             I = int c (|Xb|^2 Id - Xb Xb^T), whose xy
+                             block adds int c Xb3^2 to both diagonal
+                             entries (the same eigenvectors) */
+  double Izz, Ixz, Iyz; /**< 3D: Izz = int c (Xb1^2 + Xb2^2), Ixz =
+                             -int c Xb1 Xb3, Iyz = -int c Xb2 Xb3 (0 in 2D) */
+  double I1, I2;    /**< principal moments, I1 >= I2 (>= I3 in 3D) */
+  double I3;        /**< 3D: the smallest principal moment (0 in 2D) */
+  double v1[3], v2[3]; /**< unit eigenvectors of I1 and I2 (z = 0 in 2D) */
+  double v3[3];     /**< 3D: unit eigenvector of I3, the long axis (0 in 2D,
+                         where the long axis is v2) */
+  double angle;     /**< 2D: angle of v1 from the x axis, in (-pi/2, pi/2]
+                         (0 in 3D) */
   double area;      /**< area (3D: volume) where c_k >= 1/2 (inside the
                          membrane; at the quadrature points, whatever the
                          weight threshold) */

@@ -31,6 +31,92 @@ void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
   v2[1] = v1[0];
 }
 
+/** Cyclic Jacobi sweeps of sp_cells_principal3: each sweep squares the
+ *  off-diagonal part's size (quadratic convergence); 3x3 tensors reach
+ *  round-off in 4 to 6, so this bound is never the one that stops. */
+#define SP_JACOBI_MAX_SWEEPS 50
+
+/** The off-diagonal part counts as zero below this fraction of the
+ *  diagonal's size (under half an ulp of its largest entry). */
+#define SP_JACOBI_OFF_DIAGONAL 1e-17
+
+/** Beyond this |theta| the rotation's tangent is 1 / (2 theta) (theta^2
+ *  would overflow; the two agree to round-off long before). */
+#define SP_JACOBI_THETA_LARGE 1e150
+
+/** A generic direction, r = (-sin 0.2 cos 0.5, cos 0.2 cos 0.5, sin 0.5):
+ *  sp_cells_principal3 makes every eigenvector's r component >= 0. Its
+ *  plane r . v = 0, where round-off can flip a sign, contains no
+ *  coordinate axis, face or body diagonal; and for an axis in the xy plane
+ *  the rule is sp_cells_principal's for v2 (the long axis of 2D), so an
+ *  extruded 2D scene gets the 2D signs. */
+static void reference_direction(double r[3]) {
+  const double phi0 = 0.2, beta = 0.5;
+  r[0] = -sin(phi0) * cos(beta);
+  r[1] = cos(phi0) * cos(beta);
+  r[2] = sin(beta);
+}
+
+void sp_cells_principal3(const double tensor[3][3], double moments[3], double v[3][3]) {
+  double a[3][3], e[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}; /* e: columns */
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) a[i][j] = 0.5 * (tensor[i][j] + tensor[j][i]);
+  for (int sweep = 0; sweep < SP_JACOBI_MAX_SWEEPS; ++sweep) {
+    const double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
+    const double diag = fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2]);
+    if (off == 0.0 || off <= SP_JACOBI_OFF_DIAGONAL * diag) break;
+    for (int p = 0; p < 2; ++p)
+      for (int q = p + 1; q < 3; ++q) {
+        if (a[p][q] == 0.0) continue;
+        /* the rotation in the (p, q) plane that zeroes a[p][q]: t = tan of
+         * its angle, the smaller root of t^2 + 2 theta t - 1 = 0 */
+        const double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+        const double t = fabs(theta) > SP_JACOBI_THETA_LARGE ? 0.5 / theta
+                                             : copysign(1.0, theta) /
+                                                   (fabs(theta) + sqrt(theta * theta + 1.0));
+        const double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+        for (int k = 0; k < 3; ++k) { /* a <- a J (columns p, q) */
+          const double akp = a[k][p], akq = a[k][q];
+          a[k][p] = c * akp - s * akq;
+          a[k][q] = s * akp + c * akq;
+        }
+        for (int k = 0; k < 3; ++k) { /* a <- J^T a (rows p, q) */
+          const double apk = a[p][k], aqk = a[q][k];
+          a[p][k] = c * apk - s * aqk;
+          a[q][k] = s * apk + c * aqk;
+        }
+        a[p][q] = a[q][p] = 0.0;
+        for (int k = 0; k < 3; ++k) { /* e <- e J */
+          const double ekp = e[k][p], ekq = e[k][q];
+          e[k][p] = c * ekp - s * ekq;
+          e[k][q] = s * ekp + c * ekq;
+        }
+      }
+  }
+  /* largest first: a three-element insertion sort of the column indices */
+  int order[3] = {0, 1, 2};
+  for (int i = 1; i < 3; ++i)
+    for (int j = i; j > 0 && a[order[j]][order[j]] > a[order[j - 1]][order[j - 1]]; --j) {
+      const int swap = order[j];
+      order[j] = order[j - 1];
+      order[j - 1] = swap;
+    }
+  double r[3];
+  reference_direction(r);
+  for (int i = 0; i < 3; ++i) {
+    const int col = order[i];
+    moments[i] = a[col][col];
+    double norm = 0, dot = 0;
+    for (int k = 0; k < 3; ++k) {
+      norm += e[k][col] * e[k][col];
+      dot += e[k][col] * r[k];
+    }
+    /* one line, two unit directions: the one with r . v >= 0 */
+    const double scale = (dot < 0 ? -1.0 : 1.0) / sqrt(norm);
+    for (int k = 0; k < 3; ++k) v[i][k] = e[k][col] * scale;
+  }
+}
+
 /** The shape functions at the Gauss points, N[q][b] (the same on every
  *  element: Q1's reference values in dimension @p dim). */
 static void reference_shapes(int dim, double N[SP_Q1_MAX_QPOINTS][SP_Q1_MAX_NODES]) {
@@ -89,6 +175,32 @@ int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *
   return SP_OK;
 }
 
+/** The 3D tensor I = int c (|Xb|^2 Id - Xb Xb^T) of a cell from its
+ *  central second moments (xx = int c Xb1^2, xz = int c Xb1 Xb3, ...), its
+ *  principal moments and axes. */
+static void inertia_3d(sp_cell_obs *o, double xx, double yy, double xy, double zz, double xz,
+                       double yz) {
+  o->Ixx = yy + zz;
+  o->Iyy = xx + zz;
+  o->Izz = xx + yy;
+  o->Ixy = -xy;
+  o->Ixz = -xz;
+  o->Iyz = -yz;
+  const double tensor[3][3] = {
+      {o->Ixx, o->Ixy, o->Ixz}, {o->Ixy, o->Iyy, o->Iyz}, {o->Ixz, o->Iyz, o->Izz}};
+  double moments[3], v[3][3];
+  sp_cells_principal3(tensor, moments, v);
+  o->I1 = moments[0];
+  o->I2 = moments[1];
+  o->I3 = moments[2];
+  for (int k = 0; k < 3; ++k) {
+    o->v1[k] = v[0][k];
+    o->v2[k] = v[1][k];
+    o->v3[k] = v[2][k];
+  }
+  o->angle = 0.0;
+}
+
 int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
                      const double *state, double weight_threshold,
                      sp_cell_obs *obs) {
@@ -99,9 +211,9 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
   double N[SP_Q1_MAX_QPOINTS][SP_Q1_MAX_NODES];
   reference_shapes(dim, N);
   /* Per cell: mass, weighted mass, first and second moments (x, y), the
-   * area (2D) or volume (3D) inside the membrane, and the first moment in
-   * z (3D). */
-  enum { SUMS = 9 };
+   * area (2D) or volume (3D) inside the membrane, and in 3D the first
+   * moment in z and the second moments zz, xz, yz. */
+  enum { SUMS = 12 };
   double *sums;
   SP_ALLOC(sums, SUMS * (size_t)nc);
   for (int e = 0; e < mesh->n_elems; ++e) {
@@ -120,13 +232,15 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
         s[1] += w * cw;
         s[2] += w * cw * x[0];
         s[3] += w * cw * x[1];
-        if (dim == 3) {
-          s[8] += w * cw * x[2];
-          continue; /* the inertia tensor in 3D: issue 29's next phase */
-        }
         s[4] += w * cw * x[0] * x[0];
         s[5] += w * cw * x[1] * x[1];
         s[6] += w * cw * x[0] * x[1];
+        if (dim == 3) {
+          s[8] += w * cw * x[2];
+          s[9] += w * cw * x[2] * x[2];
+          s[10] += w * cw * x[0] * x[2];
+          s[11] += w * cw * x[1] * x[2];
+        }
       }
     }
   }
@@ -140,22 +254,25 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
     o->xc = s[2] / m;
     o->yc = s[3] / m;
     o->zc = dim == 3 ? s[8] / m : 0.0;
-    if (dim == 3) { /* no moments yet in 3D: zero, and v1, v2 the x and y axes */
-      *o = (sp_cell_obs){.mass = o->mass, .mass_core = o->mass_core, .area = o->area,
-                         .xc = o->xc, .yc = o->yc, .zc = o->zc, .v1 = {1, 0}, .v2 = {0, 1}};
-      continue;
-    }
     /* Central moments: int c Xb1^2 = int c x^2 - m xc^2, etc. */
     const double xx = s[4] - m * o->xc * o->xc;
     const double yy = s[5] - m * o->yc * o->yc;
     const double xy = s[6] - m * o->xc * o->yc;
+    if (dim == 3) {
+      inertia_3d(o, xx, yy, xy, s[9] - m * o->zc * o->zc, s[10] - m * o->xc * o->zc,
+                 s[11] - m * o->yc * o->zc);
+      continue;
+    }
     o->Ixx = yy;
     o->Iyy = xx;
     o->Ixy = -xy;
     sp_cells_principal(o->Ixx, o->Iyy, o->Ixy, &o->I1, &o->I2, o->v1, o->v2);
+    o->v1[2] = o->v2[2] = 0.0;
     o->angle = atan2(o->v1[1], o->v1[0]);
     if (o->angle <= -M_PI / 2) o->angle += M_PI;
     if (o->angle > M_PI / 2) o->angle -= M_PI;
+    o->Izz = o->Ixz = o->Iyz = o->I3 = 0.0;
+    o->v3[0] = o->v3[1] = o->v3[2] = 0.0;
   }
   free(sums);
   return SP_OK;
@@ -194,11 +311,37 @@ int sp_cells_fill(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *l
   return SP_OK;
 }
 
-/** The scene's cell k: a disk (2D) or a sphere (3D) with the
- *  tanh profile of width d, or sharp. */
+/** The signed distance from an ellipse (ellipsoid) with semi-axes s along
+ *  the coordinate axes centred at c, to first order: (rho - 1) / |grad rho|
+ *  with rho^2 = sum_j ((x_j - c_j) / s_j)^2, exact on the boundary's normals
+ *  near it and for a sphere; -min s at the centre, where rho has no
+ *  gradient. */
+static double ellipsoid_distance(const double *x, const double *c, const double *s, int dim) {
+  double rho2 = 0, grad2 = 0, smallest = s[0];
+  for (int j = 0; j < dim; ++j) {
+    const double u = (x[j] - c[j]) / s[j];
+    rho2 += u * u;
+    grad2 += (u / s[j]) * (u / s[j]);
+    smallest = fmin(smallest, s[j]);
+  }
+  if (grad2 == 0) return -smallest;
+  const double rho = sqrt(rho2);
+  return (rho - 1.0) * rho / sqrt(grad2); /* |grad rho| = sqrt(grad2) / rho */
+}
+
+/** The scene's cell k: a disk (2D) or a sphere (3D), or with semi-axes an
+ *  ellipse (ellipsoid), with the tanh profile of width d, or sharp. */
 static double disk_profile(int k, const double *x, int dim, void *ctx) {
   const sp_scene *scene = ctx;
   const sp_scene_cell *cell = &scene->cells[k];
+  if (sp_scene_cell_is_ellipsoid(cell)) {
+    const double c[3] = {cell->x, cell->y, cell->z};
+    double s[3] = {1, 1, 1}; /* (z unused in 2D) */
+    for (int j = 0; j < dim; ++j) s[j] = sp_scene_cell_semi_axis(cell, j);
+    const double distance = ellipsoid_distance(x, c, s, dim);
+    if (cell->profile == SP_PROFILE_SHARP) return distance <= 0 ? 1.0 : 0.0;
+    return sp_cells_profile(distance, sp_scene_interface_width(scene));
+  }
   const double r = dim == 2 ? hypot(x[0] - cell->x, x[1] - cell->y)
                             : sqrt((x[0] - cell->x) * (x[0] - cell->x) +
                                    (x[1] - cell->y) * (x[1] - cell->y) +

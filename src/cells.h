@@ -1,7 +1,7 @@
 /**
  * @file cells.h
  * @brief The cell registry and the geometric observables of each cell
- *        computed from its field c_k alone (mesh integrals, 2x2 Gauss).
+ *        computed from its field c_k alone (mesh integrals, 2x2 or 2x2x2 Gauss).
  */
 #ifndef SP_CELLS_H
 #define SP_CELLS_H
@@ -53,6 +53,20 @@ int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *
  *         tensor, larger first (v1 is the larger moment's). */
 void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
                         double *I2, double v1[2], double v2[2]);
+
+/**
+ * @brief Principal moments and unit eigenvectors of a symmetric 3x3 tensor
+ *        (cyclic Jacobi), largest first: moments[0] >= moments[1] >=
+ *        moments[2], v[i] the unit eigenvector of moments[i].
+ *
+ * Well defined when two or three moments are equal (a sphere): the
+ * eigenvectors are then an orthonormal basis of the degenerate space, never
+ * NaN. Each v[i] is signed so that its component along a fixed generic
+ * direction (cells.c) is >= 0: the same sign from runs that differ in
+ * round-off, and for a vector in the xy plane the sign rule of
+ * sp_cells_principal's v2.
+ */
+void sp_cells_principal3(const double tensor[3][3], double moments[3], double v[3][3]);
 
 /**
  * @brief The initial fields of a scene (MODEL.md): cell k's profile p_k

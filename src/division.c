@@ -94,6 +94,30 @@ void sp_division_axis(const sp_cell_obs *obs, double *px, double *py, double *dx
   *dy = obs->v1[1];
 }
 
+void sp_division_plane(const sp_cell_obs *obs, int dim, double point[3], double normal[3]) {
+  point[0] = obs->xc;
+  point[1] = obs->yc;
+  point[2] = dim == 3 ? obs->zc : 0.0;
+  if (dim == 3) {
+    for (int d = 0; d < 3; ++d) normal[d] = obs->v3[d];
+    return;
+  }
+  double px, py, dx, dy;
+  sp_division_axis(obs, &px, &py, &dx, &dy);
+  normal[0] = -dy; /* n = v2: v1 turned by +90 degrees */
+  normal[1] = dx;
+  normal[2] = 0.0;
+}
+
+/** Signed distance n . (X_i - P) of node i from the cut through P normal
+ *  to n (2D: the line's, as written before 3D, so the same rounding). */
+static double node_distance(const sp_mesh *mesh, int i, const double point[3],
+                            const double normal[3]) {
+  const double *x = mesh->xy + (size_t)mesh->dim * i;
+  const double in_plane = normal[0] * (x[0] - point[0]) + normal[1] * (x[1] - point[1]);
+  return mesh->dim == 3 ? in_plane + normal[2] * (x[2] - point[2]) : in_plane;
+}
+
 double sp_division_child_share(double sd, int smooth, double width, double on_line) {
   if (smooth) return 1.0 / (1.0 + exp(-sd / width));
   if (sd > on_line) return 1.0;
@@ -106,8 +130,6 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
                       const sp_cell_obs *parent_obs, int smooth, double width,
                       double offset, const sp_layout *new_layout, double *new_state,
                       int child) {
-  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
-           "division: divisions are not yet on a 3D mesh (issue 29)");
   SP_CHECK(layout->n_nodes == mesh->n_nodes && new_layout->n_nodes == mesh->n_nodes,
            SP_ERR_INTERNAL, "division split: layouts have %d and %d nodes, the mesh %d",
            layout->n_nodes, new_layout->n_nodes, mesh->n_nodes);
@@ -125,15 +147,13 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
    * from the old layout, so its pairs start at c = mu = 0. */
   sp_layout_transfer(layout, state, new_layout, new_state, 0.0);
 
-  double px, py, dx, dy;
-  sp_division_axis(parent_obs, &px, &py, &dx, &dy);
-  const double nx = -dy, ny = dx; /* n = v2: v1 turned by +90 degrees */
+  double point[3], normal[3];
+  sp_division_plane(parent_obs, mesh->dim, point, normal);
   const double on_line = SP_DIVISION_ON_LINE_FRACTION * mesh->h;
   for (int i = 0; i < mesh->n_nodes; ++i) {
     const int p_old = sp_layout_pair(layout, parent, i);
     if (p_old < 0) continue;
-    const double sd =
-        nx * (mesh->xy[2 * i] - px) + ny * (mesh->xy[2 * i + 1] - py) - offset;
+    const double sd = node_distance(mesh, i, point, normal) - offset;
     const double share = sp_division_child_share(sd, smooth, width, on_line);
     const double c = state[2 * p_old], mu = state[2 * p_old + 1];
     /* parent = c - child, not c (1 - H): the two then add up to c. */
@@ -144,11 +164,12 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
     SP_CHECK(p_child >= 0 || c_child == 0.0, SP_ERR_INTERNAL,
              "division split: node %d (%g, %g) has no pair of the child %d but receives "
              "c = %g from parent %d: the child's support must cover the parent's side",
-             i, mesh->xy[2 * i], mesh->xy[2 * i + 1], child, c_child, parent);
+             i, mesh->xy[(size_t)mesh->dim * i], mesh->xy[(size_t)mesh->dim * i + 1], child,
+             c_child, parent);
     SP_CHECK(p_parent >= 0 || c_parent == 0.0, SP_ERR_INTERNAL,
              "division split: node %d (%g, %g) has no pair of the parent %d in the new "
-             "layout but keeps c = %g", i, mesh->xy[2 * i], mesh->xy[2 * i + 1], parent,
-             c_parent);
+             "layout but keeps c = %g", i, mesh->xy[(size_t)mesh->dim * i],
+             mesh->xy[(size_t)mesh->dim * i + 1], parent, c_parent);
     if (p_child >= 0) {
       new_state[2 * p_child] = c_child;
       new_state[2 * p_child + 1] = mu_child;
@@ -183,8 +204,6 @@ int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
                                const sp_cell_obs *parent_obs, int smooth, double width,
                                double fraction, double *offset) {
   *offset = 0.0;
-  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
-           "division: divisions are not yet on a 3D mesh (issue 29)");
 
   /* w_i = int phi_i over the parent's whole elements (sp_cells_observe's rule) */
   const size_t nn = (size_t)mesh->n_nodes;
@@ -196,17 +215,17 @@ int sp_division_balance_offset(const sp_mesh *mesh, const sp_layout *layout,
     free(buffer);
     return rc;
   }
-  /* the parent's nodes: weight, value, signed distance from the centre line */
+  /* the parent's nodes: weight, value, signed distance from the centre cut */
   int n = 0;
-  double px, py, dx, dy;
-  sp_division_axis(parent_obs, &px, &py, &dx, &dy);
+  double point[3], normal[3];
+  sp_division_plane(parent_obs, mesh->dim, point, normal);
   double lo = 0, hi = 0, total = 0;
   for (int i = 0; i < mesh->n_nodes; ++i) {
     const int p = sp_layout_pair(layout, parent, i);
     if (p < 0 || w_node[i] == 0) continue;
     w[n] = w_node[i];
     c[n] = state[2 * p];
-    sd[n] = -dy * (mesh->xy[2 * i] - px) + dx * (mesh->xy[2 * i + 1] - py);
+    sd[n] = node_distance(mesh, i, point, normal);
     total += w[n] * c[n];
     if (sd[n] < lo) lo = sd[n];
     if (sd[n] > hi) hi = sd[n];

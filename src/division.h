@@ -57,7 +57,9 @@ typedef struct {
 /** A division, as divisions.csv reports it. */
 typedef struct {
   int parent, child;
-  double angle;          /**< of the division axis, in (-pi/2, pi/2] */
+  double angle;          /**< 2D: of the division axis, in (-pi/2, pi/2] */
+  double axis[3];        /**< the parent's long axis, the cut's unit normal
+                              (sp_division_plane; 2D: z = 0) */
   double parent_mass;    /**< before the cut */
   double mass_a, mass_b; /**< the daughters' right after it */
   sp_cell_name parent_name, name_a, name_b; /**< named cells (lineage.h) */
@@ -162,8 +164,9 @@ double sp_division_crossing_fraction(const sp_division_params *params,
 double sp_division_child_share(double sd, int smooth, double width, double on_line);
 
 /**
- * @brief The division line of a cell: through its centre of mass along v1,
- *        the unit eigenvector of the LARGEST principal moment I1 (MODEL.md).
+ * @brief The division line of a cell in 2D: through its centre of mass
+ *        along v1, the unit eigenvector of the LARGEST principal moment I1
+ *        (MODEL.md); sp_division_plane gives the cut in either dimension.
  *
  * For an ellipse elongated along x, I1 = int c Xb1^2 is the larger moment and
  * v1 is the y axis: the cell is cut across its length.
@@ -176,20 +179,39 @@ void sp_division_axis(const sp_cell_obs *obs, double *px, double *py,
                       double *dx, double *dy);
 
 /**
+ * @brief The cut of a division in dimension @p dim: through the centre of
+ *        mass Xc, normal to the cell's long axis.
+ *
+ * The long axis is the unit eigenvector of the SMALLEST principal moment of
+ * the inertia tensor (the direction of largest variance of c about Xc):
+ * 2D: v2 = (-v1_y, v1_x), the normal of the line along v1 of
+ * sp_division_axis (v1 is the LARGEST moment's, MODEL.md); 3D: v3, the
+ * plane's normal. In 3D the largest moment does not name the cut: a
+ * prolate cell (a cigar) has I1 = I2, and a plane normal to any of their
+ * eigenvectors would contain the long axis; the plane normal to v3 cuts it
+ * across its length, as the 2D line does.
+ *
+ * @param[out] point Xc (2D: z = 0)
+ * @param[out] normal the unit normal n (2D: n_z = 0)
+ */
+void sp_division_plane(const sp_cell_obs *obs, int dim, double point[3], double normal[3]);
+
+/**
  * @brief Split cell @p parent into itself and a new cell @p child on a layout
  *        with one more cell (paper section 2.3).
  *
- * With the axis of sp_division_axis (centre Xc, direction v1), the unit
- * normal n = v2 = (-v1_y, v1_x) (v1 turned by +90 degrees) and the line
- * moved by @p offset along n (0: through the centre of mass, the paper;
- * sp_division_balance_offset: the line that halves the mass), the signed
+ * With the cut of sp_division_plane (2D: the line through Xc along v1,
+ * with the unit normal n = v2 = (-v1_y, v1_x), v1 turned by +90 degrees;
+ * 3D: the plane through Xc normal to n = v3, the long axis) moved by
+ * @p offset along n (0: through the centre of mass, the paper;
+ * sp_division_balance_offset: the cut that halves the mass), the signed
  * distance of node X is sd = n . (X - Xc) - offset. At each node the parent's value
  * c is shared as
  *     c_child = c H(sd),   c_parent = c - c_child,
  * so c_parent + c_child = c at every node and, the mass being linear in the
  * nodal values, the parent's mass is conserved to round-off. H is
  *   - sharp (@p smooth = 0, the paper's cut): 1 for sd > 0, 0 for sd < 0,
- *     and 1/2 for a node on the line (|sd| <= 1e-9 h): a symmetric cell whose
+ *     and 1/2 for a node on the cut (|sd| <= 1e-9 h): a symmetric cell whose
  *     line runs through mesh nodes then splits into equal halves, instead of
  *     the line's nodes all going to one side;
  *   - smoothed (@p smooth = 1): H(sd) = 1 / (1 + exp(-sd / width)), the
@@ -237,9 +259,9 @@ int sp_division_split(const sp_mesh *mesh, const sp_layout *layout,
                       int child);
 
 /**
- * @brief The shift of the division line along its normal n that gives the
- *        child the share @p fraction of the parent's mass (0.5: equal
- *        halves, `division.line: equal_mass`; the lineage table's
+ * @brief The shift of the division line (3D: plane) along its normal n that
+ *        gives the child the share @p fraction of the parent's mass (0.5:
+ *        equal halves, `division.line: equal_mass`; the lineage table's
  *        asymmetric divisions, lineage.h).
  *
  * The line through the centre of mass halves only a symmetric cell: a

@@ -185,6 +185,8 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
   memcpy(record->parent_name, parent_name, sizeof parent_name);
   memcpy(record->name_a, cells->name[parent], sizeof record->name_a);
   memcpy(record->name_b, cells->name[child], sizeof record->name_b);
+  double centre[3];
+  sp_division_plane(&parent_obs, run->mesh->dim, centre, record->axis);
   return SP_OK;
 }
 

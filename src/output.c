@@ -271,9 +271,17 @@ static const struct {
     {"divisions.csv",
      "t,step,parent,child,axis_angle,parent_mass_before,parent_mass_after,child_mass_after", 1}};
 
-/** cells.csv's header on a 3D mesh: the centre with z, the volume inside
- *  the membrane; no moments yet (issue 29). */
-static const char sp_cells_header_3d[] = "step,t,cell,mass,xc,yc,zc,core_mass,volume";
+/** cells.csv's header on a 3D mesh: the centre with z, the three principal
+ *  moments, the long axis (the unit eigenvector of the smallest moment I3,
+ *  the normal of a division's cut), the volume inside the membrane. */
+static const char sp_cells_header_3d[] =
+    "step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,long_z,core_mass,volume";
+
+/** divisions.csv's header on a 3D mesh: the parent's long axis (the cut
+ *  plane's normal) instead of the 2D line's angle. */
+static const char sp_divisions_header_3d[] =
+    "t,step,parent,child,long_x,long_y,long_z,parent_mass_before,parent_mass_after,"
+    "child_mass_after";
 
 /** What named cells add to cells.csv and divisions.csv (lineage.h): the
  *  names and the lineage table's share of the first daughter. */
@@ -303,7 +311,10 @@ static int output_open(const char *dir, int dim, int named, int resume_step, sp_
   for (int i = 0; i < 3 && rc == SP_OK; ++i) {
     int exists = 0;
     if (resume_step >= 0) rc = sp_log_cut(paths[i], sp_logs[i].step_column, resume_step, &exists);
-    const char *header = i == 1 && dim == 3 ? sp_cells_header_3d : sp_logs[i].header;
+    const char *header = dim != 3 ? sp_logs[i].header
+                         : i == 1     ? sp_cells_header_3d
+                         : i == 2     ? sp_divisions_header_3d
+                                      : sp_logs[i].header;
     char *named_header =
         sp_strfmt("%s%s", header, !named ? "" : i == 1 ? sp_cells_names
                                              : i == 2 ? sp_divisions_names : "");
@@ -367,9 +378,12 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
   /* a named scene's rows end with the name */
   for (int k = 0; k < n_cells && n >= 0; ++k) {
     if (out->dim == 3)
-      n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", step, t,
-                  k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].zc, obs[k].mass_core,
-                  obs[k].area);
+      n = fprintf(out->cells,
+                  "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
+                  "%.17g,%.17g",
+                  step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].zc, obs[k].I1,
+                  obs[k].I2, obs[k].I3, obs[k].v3[0], obs[k].v3[1], obs[k].v3[2],
+                  obs[k].mass_core, obs[k].area);
     else
       n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
                   step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].I1,
@@ -381,9 +395,13 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
 }
 
 int sp_output_division(sp_output out, double t, int step, const sp_division_record *d) {
-  int n = fprintf(out->divisions, "%.17g,%d,%d,%d,%.17g,%.17g,%.17g,%.17g",
-                  t, step, d->parent + 1, d->child + 1, d->angle, d->parent_mass,
-                  d->mass_a, d->mass_b);
+  int n = out->dim == 3
+              ? fprintf(out->divisions, "%.17g,%d,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                        t, step, d->parent + 1, d->child + 1, d->axis[0], d->axis[1],
+                        d->axis[2], d->parent_mass, d->mass_a, d->mass_b)
+              : fprintf(out->divisions, "%.17g,%d,%d,%d,%.17g,%.17g,%.17g,%.17g", t, step,
+                        d->parent + 1, d->child + 1, d->angle, d->parent_mass, d->mass_a,
+                        d->mass_b);
   if (n >= 0 && out->named) {
     n = fprintf(out->divisions, ",%s,%s,%s,", d->parent_name, d->name_a, d->name_b);
     if (n >= 0 && !isnan(d->fraction)) n = fprintf(out->divisions, "%.17g", d->fraction);

@@ -26,10 +26,10 @@ typedef struct sp_output_s *sp_output;
 int sp_output_open(const char *dir, sp_output *out);
 
 /** @brief sp_output_open for a mesh of dimension @p dim (2 or 3): on a 3D
- *         mesh cells.csv is step,t,cell,mass,xc,yc,zc,core_mass,volume;
- *         @p named (the scene names its cells): cells.csv ends with a name
- *         column, divisions.csv with parent_name,first_name,second_name,
- *         fraction. */
+ *         mesh cells.csv is step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,
+ *         long_z,core_mass,volume (docs/3d.md); @p named (the scene names
+ *         its cells): cells.csv ends with a name column, divisions.csv with
+ *         parent_name,first_name,second_name,fraction. */
 int sp_output_open_dim(const char *dir, int dim, int named, sp_output *out);
 
 /** One fields file of fields.pvd: fields_<step>.vtu, or .pvtu of pieces. */
@@ -135,7 +135,9 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
 /** @brief Append one row to divisions.csv: t,step,parent,child,axis_angle,
  *         parent_mass_before,parent_mass_after,child_mass_after (cells
  *         numbered from 1; the angle is the division line's, from x; the
- *         first daughter keeps the parent's number), and with named cells
+ *         first daughter keeps the parent's number); on a 3D mesh the
+ *         angle's column is three, long_x,long_y,long_z: the parent's long
+ *         axis d->axis, the cut plane's unit normal; with named cells
  *         parent_name,first_name,second_name,fraction (the lineage table's
  *         share of the first daughter; empty for a division by the scene's
  *         division: rules). */

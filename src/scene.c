@@ -506,11 +506,11 @@ static const sp_key sp_keys[] = {
     KEY_ENUM(SP_SEC_DIVISION, "cut", division.cut, SP_CUT_SHARP, sp_cut_words,
              "-",
              "the split: sharp (the paper) or smooth (tanh of the distance "
-             "to the division line, width d)"),
+             "to the division line (3D: plane), width d)"),
     KEY_ENUM(SP_SEC_DIVISION, "line", division.line, SP_LINE_CENTRE, sp_line_words,
              "-",
-             "the division line (along the cell's length axis v1): through "
-             "the centre of mass (the paper) or moved along its normal so "
+             "the division line (3D: plane), normal to the cell's long axis: "
+             "through the centre of mass (the paper) or moved along that axis so "
              "the daughters get equal masses"),
     KEY_FLOAT(SP_SEC_DIVISION, "observe_threshold", division.observe_threshold,
               0.05, AT_LEAST(0.0), BELOW(0.5), "-",
@@ -598,6 +598,14 @@ static const sp_key sp_keys[] = {
                "a sphere inside the box; not allowed on a 2D one"),
     CELL_FLOAT_REQUIRED("radius", radius, ABOVE(0.0), UNBOUNDED, "L",
                         "radius of the c = 1/2 level set"),
+    CELL_FLOAT("semi_x", semi_x, NAN, ABOVE(0.0), UNBOUNDED, "L",
+               "semi-axis along x of an elongated cell (none: radius): with semi_y, "
+               "semi_z the cell is the ellipse (ellipsoid) with these semi-axes along "
+               "the coordinate axes, radius the ones not given; it must lie inside Omega"),
+    CELL_FLOAT("semi_y", semi_y, NAN, ABOVE(0.0), UNBOUNDED, "L",
+               "semi-axis along y (none: radius); see semi_x"),
+    CELL_FLOAT("semi_z", semi_z, NAN, ABOVE(0.0), UNBOUNDED, "L",
+               "semi-axis along z (none: radius); only on a 3D mesh; see semi_x"),
     CELL_ENUM("profile", profile, SP_PROFILE_TANH, sp_profile_words, "-",
               "initial profile: tanh (equilibrium width d) or sharp (0/1)"),
     NAME_KEY(SP_SEC_CELLS, sp_scene_cell, "name", name, 0,
@@ -1519,15 +1527,13 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
 #define SP_NOT_YET_3D "not yet in 3D (mesh.type box; issue 29)"
 
 /** What a scene on a 3D mesh cannot ask for yet, each refused naming its
- *  key, rather than run wrong: divisions, the shape term, local supports,
- *  pictures, checkpoints and initial fields from files (the VTU fields are
- *  not written in 3D: no key asks for them). */
+ *  key, rather than run wrong: the shape term, local supports, pictures,
+ *  checkpoints and initial fields from files (the VTU fields are not
+ *  written in 3D: no key asks for them). */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
-  SP_CHECK(scene->division.criterion == SP_DIVIDE_NONE, SP_ERR_INPUT,
-           "%s: division.criterion: divisions are " SP_NOT_YET_3D ": expected none", file);
   SP_CHECK(scene->n_lineage == 0, SP_ERR_INPUT,
-           "%s: lineage: divisions are " SP_NOT_YET_3D ": expected no lineage table", file);
+           "%s: lineage: a lineage table is " SP_NOT_YET_3D ": expected none", file);
   SP_CHECK(scene->shape.delta1 == 0, SP_ERR_INPUT,
            "%s: shape.delta1: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
            scene->shape.delta1);
@@ -1541,6 +1547,16 @@ static int check_3d(const sp_scene *scene, const char *file) {
            "%s: layout.support: local supports are " SP_NOT_YET_3D
            ": expected full (auto is local beyond 4 cells; the scene has %d)",
            file, scene->n_cells);
+  /* ... or when divisions can make more than 4 (N_max from the volume is
+   * only known with the mesh: then full must be asked for) */
+  const int max_cells = scene->division.max_cells;
+  SP_CHECK(scene->layout.support == SP_SUPPORT_FULL ||
+               scene->division.criterion == SP_DIVIDE_NONE || (max_cells >= 1 && max_cells <= 4),
+           SP_ERR_INPUT,
+           "%s: layout.support: local supports are " SP_NOT_YET_3D
+           ": expected full for a scene with divisions (auto is local when divisions can make "
+           "more than 4 cells; division.max_cells = %d, 0: from the volume)",
+           file, max_cells);
   SP_CHECK(!scene->output.pictures, SP_ERR_INPUT,
            "%s: output.pictures: pictures are " SP_NOT_YET_3D ": expected false", file);
   SP_CHECK(scene->output.checkpoint_every == 0, SP_ERR_INPUT,
@@ -1558,7 +1574,16 @@ static int check_3d(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
-/** Every cell's centre, and its whole sphere, inside the box; its z given. */
+/** The key that sets cell @p c's extent along @p d: its semi-axis if
+ *  given, else its radius. */
+static const char *extent_key(const sp_scene_cell *c, int d) {
+  static const char *const semi[3] = {"semi_x", "semi_y", "semi_z"};
+  const double given[3] = {c->semi_x, c->semi_y, c->semi_z};
+  return isnan(given[d]) ? "radius" : semi[d];
+}
+
+/** Every cell's centre, and its whole sphere (ellipsoid), inside the box;
+ *  its z given. */
 static int check_sphere(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
                         const char *file) {
   SP_CHECK(!isnan(c->z), SP_ERR_INPUT,
@@ -1572,7 +1597,16 @@ static int check_sphere(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
              "%s: cells[%d].%s: the centre %s = %.15g is outside the box's [mesh.%s0, "
              "mesh.%s1] = [%.15g, %.15g]",
              file, i, name[d], name[d], x[d], name[d], name[d], lo[d], hi[d]);
-  for (int d = 0; d < 3; ++d)
+  for (int d = 0; d < 3 && sp_scene_cell_is_ellipsoid(c); ++d) {
+    const double s = sp_scene_cell_semi_axis(c, d);
+    SP_CHECK(x[d] - s >= lo[d] && x[d] + s <= hi[d], SP_ERR_INPUT,
+             "%s: cells[%d].%s: the ellipsoid's semi-axis %.15g along %s around (%.15g, "
+             "%.15g, %.15g) is not inside the box [%.15g, %.15g] x [%.15g, %.15g] x [%.15g, "
+             "%.15g]",
+             file, i, extent_key(c, d), s, name[d], x[0], x[1], x[2], lo[0], hi[0], lo[1],
+             hi[1], lo[2], hi[2]);
+  }
+  for (int d = 0; d < 3 && !sp_scene_cell_is_ellipsoid(c); ++d)
     SP_CHECK(x[d] - r >= lo[d] && x[d] + r <= hi[d], SP_ERR_INPUT,
              "%s: cells[%d].radius: the sphere of radius %.15g around (%.15g, %.15g, %.15g) "
              "is not inside the box [%.15g, %.15g] x [%.15g, %.15g] x [%.15g, %.15g]",
@@ -1585,7 +1619,7 @@ static double ellipse_level(const sp_scene_mesh *m, double x, double y) {
   return (x / m->semi_x) * (x / m->semi_x) + (y / m->semi_y) * (y / m->semi_y);
 }
 
-/** Cell @p i's centre, and its whole disk, inside the rectangle. */
+/** Cell @p i's centre, and its whole disk (ellipse), inside the rectangle. */
 static int check_disk_in_rectangle(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
                                    const char *file) {
   const double r = c->radius;
@@ -1597,6 +1631,18 @@ static int check_disk_in_rectangle(const sp_scene_mesh *m, const sp_scene_cell *
            "%s: cells[%d].y: the centre y = %.15g is outside the "
            "rectangle's [mesh.y0, mesh.y1] = [%.15g, %.15g]",
            file, i, c->y, m->y0, m->y1);
+  if (sp_scene_cell_is_ellipsoid(c)) {
+    for (int d = 0; d < 2; ++d) {
+      const double x = d == 0 ? c->x : c->y, s = sp_scene_cell_semi_axis(c, d);
+      const double lo = d == 0 ? m->x0 : m->y0, hi = d == 0 ? m->x1 : m->y1;
+      SP_CHECK(x - s >= lo && x + s <= hi, SP_ERR_INPUT,
+               "%s: cells[%d].%s: the ellipse's semi-axis %.15g along %s around (%.15g, "
+               "%.15g) is not inside the rectangle [%.15g, %.15g] x [%.15g, %.15g]",
+               file, i, extent_key(c, d), s, d == 0 ? "x" : "y", c->x, c->y, m->x0, m->x1,
+               m->y0, m->y1);
+    }
+    return SP_OK;
+  }
   SP_CHECK(c->x - r >= m->x0 && c->x + r <= m->x1 && c->y - r >= m->y0 &&
                c->y + r <= m->y1,
            SP_ERR_INPUT,
@@ -1618,14 +1664,22 @@ static int check_disk_in_ellipse(const sp_scene_mesh *m, const sp_scene_cell *c,
            "%.6g)",
            file, i, i, c->x, c->y, m->semi_x, m->semi_y, level);
   const double full_turn = 2.0 * acos(-1.0);
+  const double rx = sp_scene_cell_semi_axis(c, 0), ry = sp_scene_cell_semi_axis(c, 1);
   for (int j = 0; j < SP_DISK_CHECK_ANGLES; ++j) {
     double angle = full_turn * j / SP_DISK_CHECK_ANGLES;
-    double px = c->x + r * cos(angle), py = c->y + r * sin(angle);
-    SP_CHECK(ellipse_level(m, px, py) <= 1.0, SP_ERR_INPUT,
-             "%s: cells[%d].radius: the disk of radius %.15g around "
-             "(%.15g, %.15g) is not inside the ellipse with semi-axes "
-             "(%.15g, %.15g): its point (%.6g, %.6g) is outside",
-             file, i, r, c->x, c->y, m->semi_x, m->semi_y, px, py);
+    double px = c->x + rx * cos(angle), py = c->y + ry * sin(angle);
+    if (!sp_scene_cell_is_ellipsoid(c))
+      SP_CHECK(ellipse_level(m, px, py) <= 1.0, SP_ERR_INPUT,
+               "%s: cells[%d].radius: the disk of radius %.15g around "
+               "(%.15g, %.15g) is not inside the ellipse with semi-axes "
+               "(%.15g, %.15g): its point (%.6g, %.6g) is outside",
+               file, i, r, c->x, c->y, m->semi_x, m->semi_y, px, py);
+    else
+      SP_CHECK(ellipse_level(m, px, py) <= 1.0, SP_ERR_INPUT,
+               "%s: cells[%d].semi_x, cells[%d].semi_y: the cell's ellipse with semi-axes "
+               "(%.15g, %.15g) around (%.15g, %.15g) is not inside the ellipse with "
+               "semi-axes (%.15g, %.15g): its point (%.6g, %.6g) is outside",
+               file, i, i, rx, ry, c->x, c->y, m->semi_x, m->semi_y, px, py);
   }
   return SP_OK;
 }
@@ -1643,6 +1697,10 @@ static int check_cells(const sp_scene *scene, const char *file) {
     SP_CHECK(isnan(c->z), SP_ERR_INPUT,
              "%s: cells[%d].z: only on a 3D mesh (mesh.type box), got %.15g with mesh.type %s",
              file, i, c->z, m->type == SP_MESH_RECTANGLE ? "rectangle" : "ellipse");
+    SP_CHECK(isnan(c->semi_z), SP_ERR_INPUT,
+             "%s: cells[%d].semi_z: only on a 3D mesh (mesh.type box), got %.15g with "
+             "mesh.type %s",
+             file, i, c->semi_z, m->type == SP_MESH_RECTANGLE ? "rectangle" : "ellipse");
     if (m->type == SP_MESH_RECTANGLE) SP_CALL(check_disk_in_rectangle(m, c, i, file));
     else SP_CALL(check_disk_in_ellipse(m, c, i, file));
   }
@@ -1844,6 +1902,15 @@ static int fill_scene(sp_scene *scene, const char *path, const char *text,
   SP_CALL(check_lineage(scene, where));
   SP_CALL(check_sizes(scene, where));
   return SP_OK;
+}
+
+double sp_scene_cell_semi_axis(const sp_scene_cell *cell, int d) {
+  const double given = d == 0 ? cell->semi_x : d == 1 ? cell->semi_y : cell->semi_z;
+  return isnan(given) ? cell->radius : given;
+}
+
+int sp_scene_cell_is_ellipsoid(const sp_scene_cell *cell) {
+  return !isnan(cell->semi_x) || !isnan(cell->semi_y) || !isnan(cell->semi_z);
 }
 
 int sp_scene_dim(const sp_scene *scene) { return scene->mesh.type == SP_MESH_BOX ? 3 : 2; }

@@ -89,6 +89,9 @@ typedef struct {
   double z;        /**< centre z: given on a 3D mesh (a sphere), NaN (not
                         given) on a 2D one */
   double radius;   /**< radius of the c = 1/2 level set */
+  double semi_x, semi_y, semi_z; /**< semi-axes of an ellipse (ellipsoid)
+                        cell along x, y, z; NaN (not given): the radius
+                        (sp_scene_cell_semi_axis); semi_z only in 3D */
   sp_profile_kind profile; /**< tanh (equilibrium width) or sharp */
   char name[SP_CELL_NAME_MAX]; /**< its name ("": none; lineage.h) */
 } sp_scene_cell;
@@ -112,6 +115,14 @@ typedef struct {
   sp_axis_kind axis;             /**< the cut's normal */
   double direction[3]; /**< axis fixed: the normal (x, y, z; NaN: not given) */
 } sp_scene_lineage;
+
+/** @brief The semi-axis of @p cell along coordinate @p d (0, 1, 2): its
+ *         semi_x, semi_y or semi_z if given, else its radius. */
+double sp_scene_cell_semi_axis(const sp_scene_cell *cell, int d);
+
+/** @brief 1 if @p cell gives any semi-axis (an ellipse or ellipsoid), 0 for
+ *         a disk or sphere of its radius. */
+int sp_scene_cell_is_ellipsoid(const sp_scene_cell *cell);
 
 /** noise: the initial background of every field. */
 typedef struct {

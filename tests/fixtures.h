@@ -166,6 +166,51 @@ static inline void set_ellipse(const sp_mesh *mesh, const sp_layout *layout, dou
   }
 }
 
+static inline double dot3(const double *a, const double *b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline double norm3(const double *a) { return sqrt(dot3(a, a)); }
+
+/** The angle between two lines (undirected) in 3D, in [0, pi/2]. */
+static inline double line_angle3(const double *a, const double *b) {
+  const double c[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                       a[0] * b[1] - a[1] * b[0]};
+  return atan2(norm3(c), fabs(dot3(a, b)));
+}
+
+/** The 3D twin of set_ellipse on a 3D mesh: c_k = 1 / (1 + exp((rho - 1) /
+ *  eps)), rho^2 = sum_j (u_j / semi[j])^2 with u_j = axes[j] . (X - centre)
+ *  (axes: three orthonormal rows), no background; mu_k = 0. */
+static inline void set_ellipsoid(const sp_mesh *mesh, const sp_layout *layout, double *state,
+                                 int k, const double centre[3], const double axes[3][3],
+                                 const double semi[3], double eps) {
+  for (int i = 0; i < mesh->n_nodes; ++i) {
+    const int p = sp_layout_pair(layout, k, i);
+    if (p < 0) continue;
+    const double *x = mesh->xy + 3 * (size_t)i;
+    double rho2 = 0;
+    for (int j = 0; j < 3; ++j) {
+      const double u = axes[j][0] * (x[0] - centre[0]) + axes[j][1] * (x[1] - centre[1]) +
+                       axes[j][2] * (x[2] - centre[2]);
+      rho2 += (u / semi[j]) * (u / semi[j]);
+    }
+    state[2 * p] = 1.0 / (1.0 + exp((sqrt(rho2) - 1.0) / eps));
+    state[2 * p + 1] = 0.0;
+  }
+}
+
+/** Orthonormal rows: the rotation R_z(a) R_y(b) R_z(c) applied to the x,
+ *  y, z axes (row j = R e_j). */
+static inline void rotated_axes(double a, double b, double c, double axes[3][3]) {
+  const double ca = cos(a), sa = sin(a), cb = cos(b), sb = sin(b), cc = cos(c), sc = sin(c);
+  const double R[3][3] = {{ca * cb * cc - sa * sc, -ca * cb * sc - sa * cc, ca * sb},
+                          {sa * cb * cc + ca * sc, -sa * cb * sc + ca * cc, sa * sb},
+                          {-sb * cc, sb * sc, cb}};
+  for (int j = 0; j < 3; ++j)
+    for (int d = 0; d < 3; ++d) axes[j][d] = R[d][j];
+}
+
 static inline double energy_total(sp_solver s, const sp_model_params *m, const double *state) {
   sp_energy_parts e;
   if (sp_solver_energy(s, m, state, &e) != 0) {

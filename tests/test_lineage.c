@@ -101,7 +101,6 @@ static void test_asymmetric_split(void) {
   split_teardown(&mesh, &layout, &new_layout, &state, &new_state);
 }
 
-static double norm3(const double *v) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
 /* The axis rules' normals. */
 static void test_normals(void) {

@@ -10,7 +10,8 @@
  *    the Gauss points of elements of 0.36 r) and the centre
  *    its (x, y, z) (within 1e-3 of the box);
  *  - what a 3D run writes: energy.csv, cells.csv with the z centre
- *    (step,t,cell,mass,xc,yc,zc,core_mass,volume), energy.png, and no VTU
+ *    (step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,long_z,core_mass,
+ *    volume), energy.png, and no VTU
  *    fields or cell pictures (not yet in 3D). */
 #include <string.h>
 #include <sys/stat.h>
@@ -47,15 +48,17 @@ static void relax(const char *scene_file, const char *out, int expect_cells) {
   FILE *f = fopen(path, "r");
   CHECK(f != NULL, "%s missing", path);
   CHECK(fgets(line, sizeof line, f) &&
-            strcmp(line, "step,t,cell,mass,xc,yc,zc,core_mass,volume\n") == 0,
+            strcmp(line, "step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,long_z,core_mass,"
+                         "volume\n") == 0,
         "cells.csv header: %s", line);
   double last_mass[MAX_CELLS], worst_mass = 0;
   int cell_rows = 0;
   while (fgets(line, sizeof line, f)) {
     int step, k;
-    double t, mass, xc, yc, zc, core, volume;
-    CHECK(sscanf(line, "%d,%lf,%d,%lf,%lf,%lf,%lf,%lf,%lf", &step, &t, &k, &mass, &xc, &yc, &zc,
-                 &core, &volume) == 9,
+    double t, mass, xc, yc, zc, moment[3], axis[3], core, volume;
+    CHECK(sscanf(line, "%d,%lf,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf", &step, &t, &k,
+                 &mass, &xc, &yc, &zc, &moment[0], &moment[1], &moment[2], &axis[0], &axis[1],
+                 &axis[2], &core, &volume) == 15,
           "cells row %s", line);
     CHECK(k >= 1 && k <= expect_cells, "cell %d", k);
     if (step == 0) {

@@ -3,9 +3,12 @@
  *    z0, z1, nz;
  *  - bad 3D input is refused as bad input (SP_ERR_INPUT) with a message
  *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
- *    the box, a z on a 2D mesh, and each feature not yet in 3D (division,
- *    shape term, local supports explicit or by auto with 5 cells,
- *    pictures, checkpoints, initial fields from files) with "not yet";
+ *    the box, a z on a 2D mesh, and each feature not yet in 3D (shape
+ *    term, local supports explicit or by auto with 5 cells or with
+ *    divisions that can make more than 4, pictures, checkpoints, initial
+ *    fields from files) with "not yet";
+ *  - divisions load in 3D (phase 2) with layout.support full, or auto with
+ *    division.max_cells <= 4;
  *  - `softpack run` of such a scene exits 2, names the key and writes
  *    nothing. */
 #include <string.h>
@@ -61,7 +64,15 @@ int main(void) {
   refused(box, "  - {x: 0.3, y: 0.25, z: 0.35, radius: 0.1}\n", "cells[1].radius", "sphere");
   refused(box, "  - {x: 0.3, y: 0.25, z: 0.5, radius: 0.1}\n", "cells[1].z", "outside");
   refused("mesh: {type: rectangle, x1: 0.6, y1: 0.5}\n", "", "cells[0].z", "3D mesh");
-  refused(NULL, "division: {criterion: age}\n", "division.criterion", "not yet in 3D");
+  refused(NULL, "division: {criterion: age}\n", "layout.support", "not yet in 3D");
+  refused(NULL, "division: {criterion: mass, max_cells: 5}\n", "layout.support", "not yet in 3D");
+  const char *divides[] = {"division: {criterion: age}\nlayout: {support: full}\n",
+                           "division: {criterion: mass, max_cells: 4}\n"};
+  for (int i = 0; i < 2; ++i) {
+    CHECK_OK(load(NULL, divides[i], &scene));
+    CHECK(scene->division.criterion != SP_DIVIDE_NONE, "%s: no division", divides[i]);
+    sp_scene_destroy(&scene);
+  }
   refused(NULL, "shape: {delta2: 1e5}\n", "shape.delta2", "not yet in 3D");
   refused(NULL, "layout: {support: local}\n", "layout.support", "not yet in 3D");
   refused(NULL,
@@ -79,7 +90,7 @@ int main(void) {
   /* the program: exit 2, the key named, nothing written */
   FILE *f = fopen("test_scene_3d.yaml", "w");
   CHECK(f != NULL, "cannot write the scene");
-  fprintf(f, "%s%s%sdivision: {criterion: mass}\n", good_mesh, good_output, good_cells);
+  fprintf(f, "%s%s%sshape: {delta1: 1e5}\n", good_mesh, good_output, good_cells);
   fclose(f);
   char out[4096];
   const int status =
@@ -87,7 +98,7 @@ int main(void) {
   struct stat st;
   printf("softpack run: exit %d: %s", status, out);
   CHECK(status == 2, "exit status %d: %s", status, out);
-  CHECK(strstr(out, "division.criterion") && strstr(out, "not yet in 3D"), "output: %s", out);
+  CHECK(strstr(out, "shape.delta1") && strstr(out, "not yet in 3D"), "output: %s", out);
   CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
   /* --set turns the pictures on: refused the same way */
   const int status2 = run_softpack(
