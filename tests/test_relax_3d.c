@@ -1,14 +1,16 @@
 /* Relaxation in 3D (issue 29, phase 1), through the run as `softpack run`
  * makes it (scene, box of hexahedra, spheres, RCB, MUMPS, backward Euler,
  * s = 0, no division, no shape term):
- *  - tests/scenes/sphere_3d.yaml (one sphere) and two_spheres_3d.yaml (two
- *    touching spheres): every cell's mass is conserved to 1e-12 relative
+ *  - tests/scenes/sphere_3d.yaml (one sphere), two_spheres_3d.yaml (two
+ *    touching spheres) and two_spheres_ellipsoid.yaml (two touching spheres
+ *    in an ellipsoid with a buffer shell, mesh.type ellipsoid): every
+ *    cell's mass is conserved to 1e-12 relative
  *    at every step (cells.csv, %.17g), and the energy (the pair term over
  *    k < l) never rises (1e-13 relative, as test_energy.c) and falls;
  *  - the 3D observables at t = 0: the volume inside the membrane is the
  *    sphere's 4/3 pi r^3 (within 6%: the level set counted at
- *    the Gauss points of elements of 0.36 r) and the centre
- *    its (x, y, z) (within 1e-3 of the box);
+ *    the Gauss points of elements of 0.36 r in the box, up to 0.6 r in the
+ *    ellipsoid) and the centre its (x, y, z) (within 1e-3);
  *  - what a 3D run writes: energy.csv, cells.csv with the z centre
  *    (step,t,cell,mass,xc,yc,zc,core_mass,volume), energy.png, and no VTU
  *    fields or cell pictures (not yet in 3D). */
@@ -100,6 +102,7 @@ int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   relax(SP_SOURCE_DIR "/tests/scenes/sphere_3d.yaml", "test_relax_3d_one", 1);
   relax(SP_SOURCE_DIR "/tests/scenes/two_spheres_3d.yaml", "test_relax_3d_two", 2);
+  relax(SP_SOURCE_DIR "/tests/scenes/two_spheres_ellipsoid.yaml", "test_relax_3d_ellipsoid", 2);
   MPI_Finalize();
   TEST_DONE();
 }

@@ -1,6 +1,9 @@
-/* Scenes on a 3D mesh (mesh.type box, issue 29 phase 1):
+/* Scenes on a 3D mesh (mesh.type box, ellipsoid; issue 29):
  *  - a box scene with spheres loads: dimension 3, the cells' z, the box's
- *    z0, z1, nz;
+ *    z0, z1, nz; so does an ellipsoid scene (semi_z);
+ *  - an ellipsoid without semi_z, with semi_z <= 0 or refinements > 7, a
+ *    semi_z on the 2D ellipse, a sphere poking out of the ellipsoid or
+ *    centred outside it, a cell without z: refused naming the key;
  *  - bad 3D input is refused as bad input (SP_ERR_INPUT) with a message
  *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
  *    the box, a z on a 2D mesh, and each feature not yet in 3D (division,
@@ -76,6 +79,29 @@ int main(void) {
   refused(NULL, "initial: {from: run.h5}\n", "initial.from", "not yet in 3D");
   refused(NULL, "initial: {label_image: cells.png}\n", "initial.label_image", "not yet in 3D");
 
+  /* the ellipsoid (mesh.type ellipsoid): semi_z required and > 0, only
+   * there; its refinements at most 7; spheres inside it */
+  const char *ellipsoid =
+      "mesh: {type: ellipsoid, refinements: 2, semi_x: 0.8, semi_y: 0.6, semi_z: 0.5}\n";
+  CHECK_OK(load(ellipsoid, "", &scene));
+  CHECK(sp_scene_dim(scene) == 3 && scene->mesh.type == SP_MESH_ELLIPSOID &&
+            scene->mesh.semi_z == 0.5,
+        "ellipsoid: dimension %d, semi_z %g", sp_scene_dim(scene), scene->mesh.semi_z);
+  sp_scene_destroy(&scene);
+  refused("mesh: {type: ellipsoid, refinements: 2, semi_x: 0.5, semi_y: 0.3}\n", "",
+          "mesh.semi_z", "required");
+  refused("mesh: {type: ellipsoid, semi_x: 0.5, semi_y: 0.3, semi_z: 0}\n", "", "mesh.semi_z",
+          "> 0");
+  refused("mesh: {type: ellipsoid, semi_x: 0.5, semi_y: 0.3, semi_z: -0.2}\n", "",
+          "mesh.semi_z", "> 0");
+  refused("mesh: {type: ellipsoid, refinements: 8, semi_x: 0.5, semi_y: 0.3, semi_z: 0.3}\n", "",
+          "mesh.refinements", "at most 7");
+  refused("mesh: {type: ellipse, semi_z: 0.3}\n", "", "mesh.semi_z", "only with");
+  refused(ellipsoid, "  - {x: 0.0, y: 0.0, z: 0.45, radius: 0.1}\n", "cells[1].radius",
+          "ellipsoid");
+  refused(ellipsoid, "  - {x: 0.0, y: 0.61, z: 0.0, radius: 0.01}\n", "cells[1].x", "outside");
+  refused(ellipsoid, "  - {x: 0.0, y: 0.0, radius: 0.1}\n", "cells[1].z", "required");
+
   /* the program: exit 2, the key named, nothing written */
   FILE *f = fopen("test_scene_3d.yaml", "w");
   CHECK(f != NULL, "cannot write the scene");
@@ -95,6 +121,13 @@ int main(void) {
       "--set output.pictures=true",
       out, sizeof out);
   CHECK(status2 == 2 && strstr(out, "output.pictures"), "exit %d: %s", status2, out);
+  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+  /* an ellipsoid without semi_z (by --set on a 2D scene's mesh type) */
+  const int status3 = run_softpack(
+      "run " SP_SOURCE_DIR "/tests/scenes/two_spheres_ellipsoid.yaml --quiet --out "
+      "test_scene_3d_out --set mesh.semi_z=-1",
+      out, sizeof out);
+  CHECK(status3 == 2 && strstr(out, "mesh.semi_z"), "exit %d: %s", status3, out);
   CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
   TEST_DONE();
 }
