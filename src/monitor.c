@@ -62,7 +62,7 @@ static int record_energy(sp_run *run, double dt, int its, const sp_step_costs *c
 }
 
 /** The fields of the state: a piece per rank and the .pvtu by rank 0 under
- *  MPI, else one .vtu (2D meshes: VTU hexahedra are issue 29's next phase). */
+ *  MPI, else one .vtu. */
 static int write_fields(sp_run *run) {
   sp_monitor *mon = &run->mon;
   if (run->n_ranks > 1) {
@@ -80,12 +80,12 @@ static int write_fields(sp_run *run) {
   return sp_output_fields(mon->output, run->mesh, run->layout, run->state, run->step, run->t);
 }
 
-/** The fields of the state (on a 2D mesh), its picture (output.pictures)
+/** The fields of the state, its picture (output.pictures)
  *  and energy.png. */
 static int write_snapshot(sp_run *run) {
   sp_monitor *mon = &run->mon;
   SP_CALL(sp_fault_check(SP_FAULT_OUTPUT, run->rank));
-  if (run->mesh->dim == 2) SP_CALL(write_fields(run));
+  SP_CALL(write_fields(run));
   if (run->rank != 0) return SP_OK;
   char path[4096];
   if (run->opt.output.pictures) {

@@ -98,7 +98,8 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
                     const sp_cell_obs *obs);
 
 /**
- * @brief Write fields_<step>.vtu (unstructured grid of quads; point arrays
+ * @brief Write fields_<step>.vtu (unstructured grid of the mesh's elements,
+ *        quads (VTK type 9) in 2D, hexahedra (type 12) in 3D; point arrays
  *        c_k and mu_k per cell, 0 outside a cell's support, and cell_id = the
  *        k (from 1) with the largest c_k where that c_k > 1/2, else 0) and
  *        rewrite fields.pvd listing every .vtu written so far with its time.

@@ -221,8 +221,7 @@ static const sp_key sp_keys[] = {
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
              "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
              "or an ellipsoid of hexahedra (3D; not yet with divisions, the shape "
-             "term, local supports, checkpoints, initial files, fields or pictures: "
-             "issue 29)"),
+             "term, local supports, checkpoints, initial files or pictures: issue 29)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
               "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
@@ -1394,8 +1393,7 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
 
 /** What a scene on a 3D mesh cannot ask for yet, each refused naming its
  *  key, rather than run wrong: divisions, the shape term, local supports,
- *  pictures, checkpoints and initial fields from files (the VTU fields are
- *  not written in 3D: no key asks for them). */
+ *  pictures, checkpoints and initial fields from files. */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
   SP_CHECK(scene->division.criterion == SP_DIVIDE_NONE, SP_ERR_INPUT,
