@@ -104,7 +104,8 @@ int sp_monitor_open(sp_run *run) {
   if (run->rank == 0) {
     if (run->restarted) { /* the logs cut back to the checkpoint's step */
       sp_checkpoint_remove_after(mon->out_dir, run->step);
-      rc = sp_output_resume(mon->out_dir, run->step, mon->n_fields, mon->fields, &mon->output);
+      rc = sp_output_resume(mon->out_dir, run->mesh->dim, run->step, mon->n_fields, mon->fields,
+                            &mon->output);
     } else {
       rc = sp_output_open_dim(mon->out_dir, run->mesh->dim, &mon->output);
     }
@@ -269,13 +270,6 @@ static int checkpoint_if_due(sp_run *run, int *signalled) {
   if (!(want_stop || want_time ||
         (o->checkpoint_every > 0 && run->step % o->checkpoint_every == 0)))
     return SP_OK;
-  if (run->mesh->dim != 2) { /* no checkpoints in 3D yet: a signal stops the run alone */
-    if (want_stop) atomic_store(&stop_requested, 0);
-    if (want_stop && run->rank == 0)
-      fprintf(stderr, "softpack: stopped on a signal after step %d (t = %.6g): no checkpoint "
-              "(not yet on a 3D mesh)\n", run->step, run->t);
-    return SP_OK;
-  }
   char path[4096] = "";
   const double t0 = sp_wall_clock();
   int rc = SP_OK;

@@ -757,9 +757,10 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
   return sp_pvd_write(out);
 }
 
-int sp_output_resume(const char *dir, int step, int n_fields, const sp_output_field *fields,
-                     sp_output *out) {
-  SP_CALL(output_open(dir, 2, step, out)); /* (checkpoints are 2D) */
+int sp_output_resume(const char *dir, int dim, int step, int n_fields,
+                     const sp_output_field *fields, sp_output *out) {
+  SP_CHECK(dim == 2 || dim == 3, SP_ERR_INTERNAL, "output: dimension %d", dim);
+  SP_CALL(output_open(dir, dim, step, out));
   for (int i = 0; i < n_fields; ++i)
     if (fields[i].step <= step) {
       int rc = sp_fields_record(*out, fields[i].step, fields[i].t, fields[i].pvtu);

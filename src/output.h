@@ -37,10 +37,11 @@ typedef struct {
  * @brief Continue a run in @p dir from its step @p step (a restart): the
  *        CSV logs are cut back to the rows of steps <= @p step (and a torn
  *        last line) and appended to; fields.pvd lists @p fields up to
- *        @p step. Logs that do not exist are started with their headers.
+ *        @p step. Logs that do not exist are started with their headers
+ *        (cells.csv's for a mesh of dimension @p dim, as sp_output_open_dim).
  */
-int sp_output_resume(const char *dir, int step, int n_fields, const sp_output_field *fields,
-                     sp_output *out);
+int sp_output_resume(const char *dir, int dim, int step, int n_fields,
+                     const sp_output_field *fields, sp_output *out);
 
 /** What sp_vtu_read finds in a softpack .vtu: the points (x, y) and every
  *  cell's c and mu at them (cell-major: c[k n_points + i]). */

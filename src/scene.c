@@ -221,7 +221,7 @@ static const sp_key sp_keys[] = {
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
              "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
              "or an ellipsoid of hexahedra (3D; not yet with divisions, the shape "
-             "term, local supports, checkpoints, initial files or pictures: issue 29)"),
+             "term, local supports, initial files or pictures: issue 29)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
               "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
@@ -1393,7 +1393,7 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
 
 /** What a scene on a 3D mesh cannot ask for yet, each refused naming its
  *  key, rather than run wrong: divisions, the shape term, local supports,
- *  pictures, checkpoints and initial fields from files. */
+ *  pictures and initial fields from files. */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
   SP_CHECK(scene->division.criterion == SP_DIVIDE_NONE, SP_ERR_INPUT,
@@ -1413,12 +1413,6 @@ static int check_3d(const sp_scene *scene, const char *file) {
            file, scene->n_cells);
   SP_CHECK(!scene->output.pictures, SP_ERR_INPUT,
            "%s: output.pictures: pictures are " SP_NOT_YET_3D ": expected false", file);
-  SP_CHECK(scene->output.checkpoint_every == 0, SP_ERR_INPUT,
-           "%s: output.checkpoint_every: checkpoints are " SP_NOT_YET_3D ": expected 0, got %d",
-           file, scene->output.checkpoint_every);
-  SP_CHECK(scene->output.checkpoint_seconds == 0, SP_ERR_INPUT,
-           "%s: output.checkpoint_seconds: checkpoints are " SP_NOT_YET_3D
-           ": expected 0, got %.15g", file, scene->output.checkpoint_seconds);
   SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
            "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
            ": expected none, got '%s'", file, scene->initial.from);

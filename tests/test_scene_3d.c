@@ -8,7 +8,8 @@
  *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
  *    the box, a z on a 2D mesh, and each feature not yet in 3D (division,
  *    shape term, local supports explicit or by auto with 5 cells,
- *    pictures, checkpoints, initial fields from files) with "not yet";
+ *    pictures, initial fields from files) with "not yet"; checkpoints
+ *    load;
  *  - `softpack run` of such a scene exits 2, names the key and writes
  *    nothing. */
 #include <string.h>
@@ -46,6 +47,18 @@ static void refused(const char *mesh, const char *extra, const char *key, const 
   sp_scene_destroy(&scene);
 }
 
+/** `softpack ARGS` exits 2, its message names @p key (and says @p also),
+ *  and test_scene_3d_out is not written. */
+static void run_refused(const char *args, const char *key, const char *also) {
+  char out[4096];
+  struct stat st;
+  const int status = run_softpack(args, out, sizeof out);
+  printf("softpack %s: exit %d: %s", args, status, out);
+  CHECK(status == 2, "exit status %d: %s", status, out);
+  CHECK(strstr(out, key) && (!also || strstr(out, also)), "output: %s", out);
+  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+}
+
 int main(void) {
   sp_scene *scene;
   CHECK_OK(load(NULL, "", &scene));
@@ -72,10 +85,12 @@ int main(void) {
           "  - {x: 0.1, y: 0.4, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.4, z: 0.0, radius: 0.05}\n",
           "layout.support", "not yet in 3D");
   refused(NULL, "output: {pictures: true}\n", "output.pictures", "not yet in 3D");
-  refused(NULL, "output: {pictures: false, checkpoint_every: 5}\n", "output.checkpoint_every",
-          "not yet in 3D");
-  refused(NULL, "output: {pictures: false, checkpoint_seconds: 60}\n",
-          "output.checkpoint_seconds", "not yet in 3D");
+  /* checkpoints are 3D too */
+  CHECK_OK(load(NULL, "output: {pictures: false, checkpoint_every: 5, checkpoint_seconds: 60}\n",
+                &scene));
+  CHECK(scene->output.checkpoint_every == 5, "checkpoint_every %d",
+        scene->output.checkpoint_every);
+  sp_scene_destroy(&scene);
   refused(NULL, "initial: {from: run.h5}\n", "initial.from", "not yet in 3D");
   refused(NULL, "initial: {label_image: cells.png}\n", "initial.label_image", "not yet in 3D");
 
@@ -107,27 +122,15 @@ int main(void) {
   CHECK(f != NULL, "cannot write the scene");
   fprintf(f, "%s%s%sdivision: {criterion: mass}\n", good_mesh, good_output, good_cells);
   fclose(f);
-  char out[4096];
-  const int status =
-      run_softpack("run test_scene_3d.yaml --quiet --out test_scene_3d_out", out, sizeof out);
-  struct stat st;
-  printf("softpack run: exit %d: %s", status, out);
-  CHECK(status == 2, "exit status %d: %s", status, out);
-  CHECK(strstr(out, "division.criterion") && strstr(out, "not yet in 3D"), "output: %s", out);
-  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+  run_refused("run test_scene_3d.yaml --quiet --out test_scene_3d_out", "division.criterion",
+              "not yet in 3D");
   /* --set turns the pictures on: refused the same way */
-  const int status2 = run_softpack(
-      "run " SP_SOURCE_DIR "/tests/scenes/sphere_3d.yaml --quiet --out test_scene_3d_out "
-      "--set output.pictures=true",
-      out, sizeof out);
-  CHECK(status2 == 2 && strstr(out, "output.pictures"), "exit %d: %s", status2, out);
-  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
-  /* an ellipsoid without semi_z (by --set on a 2D scene's mesh type) */
-  const int status3 = run_softpack(
-      "run " SP_SOURCE_DIR "/tests/scenes/two_spheres_ellipsoid.yaml --quiet --out "
-      "test_scene_3d_out --set mesh.semi_z=-1",
-      out, sizeof out);
-  CHECK(status3 == 2 && strstr(out, "mesh.semi_z"), "exit %d: %s", status3, out);
-  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+  run_refused("run " SP_SOURCE_DIR "/tests/scenes/sphere_3d.yaml --quiet --out test_scene_3d_out "
+              "--set output.pictures=true",
+              "output.pictures", NULL);
+  /* an ellipsoid's semi_z set below 0 */
+  run_refused("run " SP_SOURCE_DIR "/tests/scenes/two_spheres_ellipsoid.yaml --quiet --out "
+              "test_scene_3d_out --set mesh.semi_z=-1",
+              "mesh.semi_z", NULL);
   TEST_DONE();
 }
