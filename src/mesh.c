@@ -107,6 +107,28 @@ static void mesh_finish(sp_mesh *mesh) {
   mesh->h = sqrt(h2);
 }
 
+/** The arguments of the curved meshes (sp_mesh_ellipse, sp_mesh_ellipsoid):
+ *  refinements in [0, @p max_refinements], @p dim finite positive semi-axes
+ *  (a along x, b along y, c along z), buffer_layers in [0, 2^10] and, with
+ *  layers, a finite positive buffer_width. */
+static int check_curved_arguments(int refinements, int max_refinements, int dim,
+                                  const double *semi, int buffer_layers,
+                                  double buffer_width) {
+  static const char *const axis[3] = {"a (x)", "b (y)", "c (z)"};
+  SP_CHECK(refinements >= 0 && refinements <= max_refinements, SP_ERR_INPUT,
+           "mesh: refinements must be in [0, %d], got %d", max_refinements, refinements);
+  for (int d = 0; d < dim; ++d)
+    SP_CHECK(isfinite(semi[d]) && semi[d] > 0, SP_ERR_INPUT,
+             "mesh: semi-axis %s must be positive, got %g", axis[d], semi[d]);
+  SP_CHECK(buffer_layers >= 0 && buffer_layers <= 1 << SP_MESH_MAX_REFINEMENTS,
+           SP_ERR_INPUT, "mesh: buffer_layers must be in [0, %d], got %d",
+           1 << SP_MESH_MAX_REFINEMENTS, buffer_layers);
+  SP_CHECK(buffer_layers == 0 || (isfinite(buffer_width) && buffer_width > 0),
+           SP_ERR_INPUT, "mesh: buffer_width must be positive when "
+           "buffer_layers = %d > 0, got %g", buffer_layers, buffer_width);
+  return SP_OK;
+}
+
 /** x0 + (x1 - x0) i / n, returning x1 exactly for i = n. */
 static double lerp_exact_ends(double x0, double x1, int i, int n) {
   if (i == n) return x1;
@@ -441,19 +463,8 @@ int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
                     double buffer_width, sp_mesh **out) {
   SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_ellipse: out is NULL");
   *out = NULL;
-  SP_CHECK(refinements >= 0 && refinements <= SP_MESH_MAX_REFINEMENTS,
-           SP_ERR_INPUT, "mesh: refinements must be in [0, %d], got %d",
-           SP_MESH_MAX_REFINEMENTS, refinements);
-  SP_CHECK(isfinite(a) && a > 0, SP_ERR_INPUT,
-           "mesh: semi-axis a (x) must be positive, got %g", a);
-  SP_CHECK(isfinite(b) && b > 0, SP_ERR_INPUT,
-           "mesh: semi-axis b (y) must be positive, got %g", b);
-  SP_CHECK(buffer_layers >= 0 && buffer_layers <= 1 << SP_MESH_MAX_REFINEMENTS,
-           SP_ERR_INPUT, "mesh: buffer_layers must be in [0, %d], got %d",
-           1 << SP_MESH_MAX_REFINEMENTS, buffer_layers);
-  SP_CHECK(buffer_layers == 0 || (isfinite(buffer_width) && buffer_width > 0),
-           SP_ERR_INPUT, "mesh: buffer_width must be positive when "
-           "buffer_layers = %d > 0, got %g", buffer_layers, buffer_width);
+  SP_CALL(check_curved_arguments(refinements, SP_MESH_MAX_REFINEMENTS, 2, (double[]){a, b},
+                                 buffer_layers, buffer_width));
 
   disk_grid grid = {1 << refinements, (1 << refinements) + buffer_layers};
   int n = grid.n;
@@ -643,21 +654,8 @@ int sp_mesh_ellipsoid(int refinements, double a, double b, double c, int buffer_
                       double buffer_width, sp_mesh **out) {
   SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_ellipsoid: out is NULL");
   *out = NULL;
-  SP_CHECK(refinements >= 0 && refinements <= SP_MESH_ELLIPSOID_MAX_REFINEMENTS,
-           SP_ERR_INPUT, "mesh: refinements must be in [0, %d], got %d",
-           SP_MESH_ELLIPSOID_MAX_REFINEMENTS, refinements);
-  SP_CHECK(isfinite(a) && a > 0, SP_ERR_INPUT,
-           "mesh: semi-axis a (x) must be positive, got %g", a);
-  SP_CHECK(isfinite(b) && b > 0, SP_ERR_INPUT,
-           "mesh: semi-axis b (y) must be positive, got %g", b);
-  SP_CHECK(isfinite(c) && c > 0, SP_ERR_INPUT,
-           "mesh: semi-axis c (z) must be positive, got %g", c);
-  SP_CHECK(buffer_layers >= 0 && buffer_layers <= 1 << SP_MESH_MAX_REFINEMENTS,
-           SP_ERR_INPUT, "mesh: buffer_layers must be in [0, %d], got %d",
-           1 << SP_MESH_MAX_REFINEMENTS, buffer_layers);
-  SP_CHECK(buffer_layers == 0 || (isfinite(buffer_width) && buffer_width > 0),
-           SP_ERR_INPUT, "mesh: buffer_width must be positive when "
-           "buffer_layers = %d > 0, got %g", buffer_layers, buffer_width);
+  SP_CALL(check_curved_arguments(refinements, SP_MESH_ELLIPSOID_MAX_REFINEMENTS, 3,
+                                 (double[]){a, b, c}, buffer_layers, buffer_width));
   /* the nodes, and 8 entries per element, must fit an int */
   const long long n_nodes = sp_mesh_ellipsoid_nodes(refinements, buffer_layers);
   const long long n_elems = sp_mesh_ellipsoid_elements(refinements, buffer_layers);
