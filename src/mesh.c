@@ -584,9 +584,10 @@ static void ball_shell_point(const ball_grid *b, int k, const int g[3], int buff
   }
 }
 
-/** The cubed ball in its numbering, unit radius, before scaling. */
-static void ball_fill(const ball_grid *b, int buffer_layers, double buffer_width,
-                      sp_mesh *mesh) {
+/** The cubed ball's nodes in its numbering, unit radius, before scaling:
+ *  the cube's grid, and over each of its surface nodes one per shell. */
+static void ball_fill_nodes(const ball_grid *b, int buffer_layers, double buffer_width,
+                            sp_mesh *mesh) {
   const double s = SP_MESH_CUBE_HALF_WIDTH;
   const int n = b->n;
   int g[3];
@@ -600,9 +601,13 @@ static void ball_fill(const ball_grid *b, int buffer_layers, double buffer_width
           ball_shell_point(b, k, g, buffer_layers, buffer_width,
                            mesh->xy + 3 * (size_t)ball_node(b, k, g));
       }
+}
 
+/** The centre cube's n^3 hexahedra (as sp_mesh_box's), elements 0.. */
+static void ball_fill_cube(const ball_grid *b, sp_mesh *mesh) {
+  const int n = b->n;
   int e = 0;
-  for (int l = 0; l < n; ++l) /* the centre cube, as sp_mesh_box */
+  for (int l = 0; l < n; ++l)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i, ++e) {
         int *nodes = mesh->elem + 8 * (size_t)e;
@@ -613,31 +618,46 @@ static void ball_fill(const ball_grid *b, int buffer_layers, double buffer_width
         }
         mesh->region[e] = SP_REGION_OMEGA;
       }
-  /* The patches, shell by shell: over each face quad of the cube's surface
-   * (counterclockwise seen from outside), the hexahedron from shell k (its
-   * q1.h bottom face) to shell k + 1 (its top face), so det J > 0. On the
-   * face normal to axis d at side g_d = 0 or n, the tangent axes d1, d2
-   * (e_d1 x e_d2 = e_d) are walked in that order on the + side, reversed on
-   * the - side. */
-  for (int k = 0; k < b->n_shells; ++k)
-    for (int d = 0; d < 3; ++d)
-      for (int side = 0; side <= 1; ++side)
-        for (int q = 0; q < n; ++q)
-          for (int p = 0; p < n; ++p, ++e) {
-            static const int walk[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-            const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
-            int *nodes = mesh->elem + 8 * (size_t)e;
-            for (int a = 0; a < 4; ++a) {
-              const int w = side ? a : (4 - a) % 4; /* reversed: 0, 3, 2, 1 */
-              int corner[3];
-              corner[d] = side ? n : 0;
-              corner[d1] = p + walk[w][0];
-              corner[d2] = q + walk[w][1];
-              nodes[a] = ball_node(b, k, corner);
-              nodes[a + 4] = ball_node(b, k + 1, corner);
-            }
-            mesh->region[e] = k < n ? SP_REGION_OMEGA : SP_REGION_BUFFER;
+}
+
+/**
+ * The patches' hexahedra between shells k and k + 1, from element @p e on:
+ * over each face quad of the cube's surface (counterclockwise seen from
+ * outside), shell k's quad is its q1.h bottom face and shell k + 1's its
+ * top face, so det J > 0. On the face normal to axis d at side g_d = 0 or
+ * n, the tangent axes d1, d2 (e_d1 x e_d2 = e_d) are walked in that order
+ * on the + side, reversed on the - side. Returns the next element.
+ */
+static int ball_fill_shell(const ball_grid *b, int k, int e, sp_mesh *mesh) {
+  static const int walk[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const int n = b->n;
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side <= 1; ++side)
+      for (int q = 0; q < n; ++q)
+        for (int p = 0; p < n; ++p, ++e) {
+          const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+          int *nodes = mesh->elem + 8 * (size_t)e;
+          for (int a = 0; a < 4; ++a) {
+            const int w = side ? a : (4 - a) % 4; /* reversed: 0, 3, 2, 1 */
+            int corner[3];
+            corner[d] = side ? n : 0;
+            corner[d1] = p + walk[w][0];
+            corner[d2] = q + walk[w][1];
+            nodes[a] = ball_node(b, k, corner);
+            nodes[a + 4] = ball_node(b, k + 1, corner);
           }
+          mesh->region[e] = k < n ? SP_REGION_OMEGA : SP_REGION_BUFFER;
+        }
+  return e;
+}
+
+/** The cubed ball in its numbering, unit radius, before scaling. */
+static void ball_fill(const ball_grid *b, int buffer_layers, double buffer_width,
+                      sp_mesh *mesh) {
+  ball_fill_nodes(b, buffer_layers, buffer_width, mesh);
+  ball_fill_cube(b, mesh);
+  int e = b->n * b->n * b->n;
+  for (int k = 0; k < b->n_shells; ++k) e = ball_fill_shell(b, k, e, mesh);
 }
 
 long long sp_mesh_ellipsoid_nodes(int refinements, int buffer_layers) {

@@ -1332,6 +1332,26 @@ static int check_initial(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
+/** mesh.semi_z given on an ellipsoid (and only there), its refinements at
+ *  most SP_MESH_ELLIPSOID_MAX_REFINEMENTS. */
+static int check_ellipsoid_keys(const sp_scene_mesh *m, const char *file) {
+  if (m->type == SP_MESH_ELLIPSOID) {
+    SP_CHECK(!isnan(m->semi_z), SP_ERR_INPUT,
+             "%s: mesh.semi_z: required with mesh.type ellipsoid: expected the semi-axis "
+             "along z, a number > 0", file);
+    SP_CHECK(m->refinements <= SP_MESH_ELLIPSOID_MAX_REFINEMENTS, SP_ERR_INPUT,
+             "%s: mesh.refinements: expected at most %d with mesh.type ellipsoid (%d gives "
+             "%lld hexahedra), got %d", file, SP_MESH_ELLIPSOID_MAX_REFINEMENTS,
+             m->refinements, sp_mesh_ellipsoid_elements(m->refinements, m->buffer_layers),
+             m->refinements);
+  } else {
+    SP_CHECK(isnan(m->semi_z), SP_ERR_INPUT,
+             "%s: mesh.semi_z: only with mesh.type ellipsoid, got %.15g with mesh.type %s",
+             file, m->semi_z, sp_mesh_words[m->type].str);
+  }
+  return SP_OK;
+}
+
 static int check_time_and_mesh(const sp_scene *scene, const char *file) {
   const sp_scene_time *t = &scene->time;
   SP_CHECK(t->dt_min <= t->dt, SP_ERR_INPUT,
@@ -1370,22 +1390,7 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
              "%s: mesh.z1: expected a number > mesh.z0 = %.15g, got %.15g",
              file, m->z0, m->z1);
   }
-  const sp_scene_mesh *m = &scene->mesh;
-  if (m->type == SP_MESH_ELLIPSOID) {
-    SP_CHECK(!isnan(m->semi_z), SP_ERR_INPUT,
-             "%s: mesh.semi_z: required with mesh.type ellipsoid: expected the semi-axis "
-             "along z, a number > 0", file);
-    SP_CHECK(m->refinements <= SP_MESH_ELLIPSOID_MAX_REFINEMENTS, SP_ERR_INPUT,
-             "%s: mesh.refinements: expected at most %d with mesh.type ellipsoid (%d gives "
-             "%lld hexahedra), got %d", file, SP_MESH_ELLIPSOID_MAX_REFINEMENTS,
-             m->refinements, sp_mesh_ellipsoid_elements(m->refinements, m->buffer_layers),
-             m->refinements);
-  } else {
-    SP_CHECK(isnan(m->semi_z), SP_ERR_INPUT,
-             "%s: mesh.semi_z: only with mesh.type ellipsoid, got %.15g with mesh.type %s",
-             file, m->semi_z, sp_mesh_words[m->type].str);
-  }
-  return SP_OK;
+  return check_ellipsoid_keys(&scene->mesh, file);
 }
 
 /** Why a 3D scene cannot have a feature yet (issue 29's later phases). */
