@@ -167,8 +167,11 @@ static unsigned long long scene_hash(const char *text, size_t len, const char *o
   return sp_fnv1a(sp_fnv1a(SP_FNV_OFFSET, text, len), overrides, strlen(overrides));
 }
 
+/** The checksum of the node coordinates (dim per node: a 2D mesh's as
+ *  before 3D meshes existed). */
 static unsigned long long mesh_hash(const sp_mesh *mesh) {
-  return sp_fnv1a(SP_FNV_OFFSET, mesh->xy, 2 * (size_t)mesh->n_nodes * sizeof(double));
+  return sp_fnv1a(SP_FNV_OFFSET, mesh->xy,
+                  (size_t)mesh->dim * (size_t)mesh->n_nodes * sizeof(double));
 }
 
 /** The run's scalars, checksummed like every array: /header (ints) and
@@ -361,7 +364,6 @@ static void sync_path(const char *path) {
 }
 
 int sp_checkpoint_write(const sp_run *run, const char *dir, char *path_out, size_t size) {
-  SP_CHECK(run->mesh->dim == 2, SP_ERR_INPUT, "checkpoints are not yet on a 3D mesh (issue 29)");
   char path[4096], tmp[4200];
   checkpoint_path(dir, run->step, path, sizeof path);
   snprintf(tmp, sizeof tmp, "%s.tmp", path);

@@ -29,6 +29,8 @@
  *                     (solver.jacobian_carry) was filled, so a continued
  *                     run rebuilds it (absent in older files: no carry)
  *
+ * The same file in 2D and 3D: everything is per (cell, node) pair or per
+ * cell; the root attribute mesh_hash checksums the nodes' dim coordinates.
  * The mesh, its RCB numbering, the solver and the supports' search
  * structures are rebuilt from the scene (the carried factorisation from
  * /carry); there is no random state after the

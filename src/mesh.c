@@ -2,7 +2,8 @@
  * @file mesh.c
  * @brief Rectangle meshes, the paper's five-patch disk mapped to an
  *        ellipse (MODEL.md, "Mesh of the paper's runs" and "Buffer zone"),
- *        and hexahedral boxes (3D, issue 29).
+ *        and in 3D (issue 29) hexahedral boxes and its twin, the cubed ball
+ *        mapped to an ellipsoid (docs/3d.md).
  *
  * The five-patch disk of refinement r has n = 2^r elements along every patch
  * side: an n x n centre square and four n x n patches between the square's
@@ -104,6 +105,28 @@ static void mesh_finish(sp_mesh *mesh) {
     }
   }
   mesh->h = sqrt(h2);
+}
+
+/** The arguments of the curved meshes (sp_mesh_ellipse, sp_mesh_ellipsoid):
+ *  refinements in [0, @p max_refinements], @p dim finite positive semi-axes
+ *  (a along x, b along y, c along z), buffer_layers in [0, 2^10] and, with
+ *  layers, a finite positive buffer_width. */
+static int check_curved_arguments(int refinements, int max_refinements, int dim,
+                                  const double *semi, int buffer_layers,
+                                  double buffer_width) {
+  static const char *const axis[3] = {"a (x)", "b (y)", "c (z)"};
+  SP_CHECK(refinements >= 0 && refinements <= max_refinements, SP_ERR_INPUT,
+           "mesh: refinements must be in [0, %d], got %d", max_refinements, refinements);
+  for (int d = 0; d < dim; ++d)
+    SP_CHECK(isfinite(semi[d]) && semi[d] > 0, SP_ERR_INPUT,
+             "mesh: semi-axis %s must be positive, got %g", axis[d], semi[d]);
+  SP_CHECK(buffer_layers >= 0 && buffer_layers <= 1 << SP_MESH_MAX_REFINEMENTS,
+           SP_ERR_INPUT, "mesh: buffer_layers must be in [0, %d], got %d",
+           1 << SP_MESH_MAX_REFINEMENTS, buffer_layers);
+  SP_CHECK(buffer_layers == 0 || (isfinite(buffer_width) && buffer_width > 0),
+           SP_ERR_INPUT, "mesh: buffer_width must be positive when "
+           "buffer_layers = %d > 0, got %g", buffer_layers, buffer_width);
+  return SP_OK;
 }
 
 /** x0 + (x1 - x0) i / n, returning x1 exactly for i = n. */
@@ -440,19 +463,8 @@ int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
                     double buffer_width, sp_mesh **out) {
   SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_ellipse: out is NULL");
   *out = NULL;
-  SP_CHECK(refinements >= 0 && refinements <= SP_MESH_MAX_REFINEMENTS,
-           SP_ERR_INPUT, "mesh: refinements must be in [0, %d], got %d",
-           SP_MESH_MAX_REFINEMENTS, refinements);
-  SP_CHECK(isfinite(a) && a > 0, SP_ERR_INPUT,
-           "mesh: semi-axis a (x) must be positive, got %g", a);
-  SP_CHECK(isfinite(b) && b > 0, SP_ERR_INPUT,
-           "mesh: semi-axis b (y) must be positive, got %g", b);
-  SP_CHECK(buffer_layers >= 0 && buffer_layers <= 1 << SP_MESH_MAX_REFINEMENTS,
-           SP_ERR_INPUT, "mesh: buffer_layers must be in [0, %d], got %d",
-           1 << SP_MESH_MAX_REFINEMENTS, buffer_layers);
-  SP_CHECK(buffer_layers == 0 || (isfinite(buffer_width) && buffer_width > 0),
-           SP_ERR_INPUT, "mesh: buffer_width must be positive when "
-           "buffer_layers = %d > 0, got %g", buffer_layers, buffer_width);
+  SP_CALL(check_curved_arguments(refinements, SP_MESH_MAX_REFINEMENTS, 2, (double[]){a, b},
+                                 buffer_layers, buffer_width));
 
   disk_grid grid = {1 << refinements, (1 << refinements) + buffer_layers};
   int n = grid.n;
@@ -489,6 +501,221 @@ int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
 }
 
 /* ------------------------------------------------------------------------ */
+/* Cubed ball (3D)                                                          */
+/* ------------------------------------------------------------------------ */
+
+/**
+ * Half-width of the centre cube of the unit ball: the 2D rule above in 3D,
+ * the cube's side 2s equal to the diagonal distance 1 - s sqrt 3 from its
+ * corner to the sphere, s = 1/(2 + sqrt 3) ~ 0.268 (deal.II's 3D hyper_ball
+ * uses 1/(3 + sqrt 3) ~ 0.211; tests/test_mesh_3d.c prints the quality of
+ * this one).
+ */
+#define SP_MESH_CUBE_HALF_WIDTH 0.26794919243112270 /* 1/(2 + sqrt 3) */
+
+/**
+ * The cubed ball of refinement r: the centre cube's (n+1)^3 grid nodes,
+ * n = 2^r, and shells k = 1..n (+ buffer shells n+1..n+L) of 6n^2 + 2 nodes
+ * each, one per node of the cube's surface grid ("shell 0"). Node numbers:
+ * grid node (i, j, l) of the cube is (l (n+1) + j)(n+1) + i; the node of
+ * shell k >= 1 over surface node g is (n+1)^3 + (k-1)(6n^2+2) + surface[g].
+ */
+typedef struct {
+  int n;        /**< elements per cube edge and per patch, 2^r */
+  int n_shells; /**< n patch shells + buffer shells */
+  int *surface; /**< per cube grid node: its index on the surface, or -1 */
+} ball_grid;
+
+static int ball_cube_node(int n, const int g[3]) {
+  return (g[2] * (n + 1) + g[1]) * (n + 1) + g[0];
+}
+
+/** Nodes on one shell: the surface of the (n+1)^3 grid, 6n^2 + 2. */
+static long long ball_shell_nodes(long long n) { return 6 * n * n + 2; }
+
+/** Node of shell k over the cube's surface grid node g. */
+static int ball_node(const ball_grid *b, int k, const int g[3]) {
+  const int cube = ball_cube_node(b->n, g);
+  if (k == 0) return cube;
+  const int n = b->n;
+  return (n + 1) * (n + 1) * (n + 1) + (k - 1) * (int)ball_shell_nodes(n) + b->surface[cube];
+}
+
+/**
+ * Unit-ball coordinates of shell k >= 1's node over surface grid node g,
+ * the 2D ring point (disk_ring_point) in 3D: with offsets u_d = (2 g_d - n)/n
+ * in [-1, 1] (|u_d| = 1 on the node's face), the cube point S = s u and the
+ * sphere point C = t / |t| with t_d = tan(pi u_d / 4) (exactly +-1 on the
+ * face): the equiangular ("gnomonic") cubed sphere, whose restriction to a
+ * coordinate plane is the 2D patches' uniform angles. Shell k <= n is the
+ * blend (1 - k/n) S + (k/n) C, so shell n lies on the sphere; buffer shell
+ * n + m is C at radius 1 + m width / layers. Every coordinate comes from its
+ * own index by the same formula, and |t| is summed in sorted order, so the
+ * mesh is exactly symmetric under axis permutations and mirrors.
+ */
+static void ball_shell_point(const ball_grid *b, int k, const int g[3], int buffer_layers,
+                             double buffer_width, double x[3]) {
+  const double s = SP_MESH_CUBE_HALF_WIDTH;
+  const int n = b->n;
+  double u[3], t[3], t2[3];
+  for (int d = 0; d < 3; ++d) {
+    u[d] = (double)(2 * g[d] - n) / n;
+    t[d] = g[d] == 0 ? -1.0 : g[d] == n ? 1.0 : tan(0.25 * SP_MESH_PI * u[d]);
+    t2[d] = t[d] * t[d];
+  }
+  for (int i = 1; i < 3; ++i) /* sort the squares: a sum independent of the axes' order */
+    for (int j = i; j > 0 && t2[j] < t2[j - 1]; --j) {
+      const double tmp = t2[j];
+      t2[j] = t2[j - 1];
+      t2[j - 1] = tmp;
+    }
+  const double norm = sqrt(t2[0] + t2[1] + t2[2]);
+  double radius = 1;
+  if (k > n) radius = k - n == buffer_layers ? 1 + buffer_width
+                                             : 1 + (k - n) * (buffer_width / buffer_layers);
+  for (int d = 0; d < 3; ++d) {
+    const double c = t[d] / norm;
+    if (k <= n) {
+      const double eta = (double)k / n;
+      x[d] = (1 - eta) * s * u[d] + eta * c;
+    } else {
+      x[d] = radius * c;
+    }
+  }
+}
+
+/** The cubed ball's nodes in its numbering, unit radius, before scaling:
+ *  the cube's grid, and over each of its surface nodes one per shell. */
+static void ball_fill_nodes(const ball_grid *b, int buffer_layers, double buffer_width,
+                            sp_mesh *mesh) {
+  const double s = SP_MESH_CUBE_HALF_WIDTH;
+  const int n = b->n;
+  int g[3];
+  for (g[2] = 0; g[2] <= n; ++g[2])
+    for (g[1] = 0; g[1] <= n; ++g[1])
+      for (g[0] = 0; g[0] <= n; ++g[0]) {
+        double *x = mesh->xy + 3 * (size_t)ball_cube_node(n, g);
+        for (int d = 0; d < 3; ++d) x[d] = s * ((double)(2 * g[d] - n) / n);
+        if (b->surface[ball_cube_node(n, g)] < 0) continue;
+        for (int k = 1; k <= b->n_shells; ++k)
+          ball_shell_point(b, k, g, buffer_layers, buffer_width,
+                           mesh->xy + 3 * (size_t)ball_node(b, k, g));
+      }
+}
+
+/** The centre cube's n^3 hexahedra (as sp_mesh_box's), elements 0.. */
+static void ball_fill_cube(const ball_grid *b, sp_mesh *mesh) {
+  const int n = b->n;
+  int e = 0;
+  for (int l = 0; l < n; ++l)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i, ++e) {
+        int *nodes = mesh->elem + 8 * (size_t)e;
+        for (int a = 0; a < 8; ++a) {
+          const int corner[3] = {i + (sp_q1_corner(a, 0) > 0), j + (sp_q1_corner(a, 1) > 0),
+                                 l + (sp_q1_corner(a, 2) > 0)};
+          nodes[a] = ball_cube_node(n, corner);
+        }
+        mesh->region[e] = SP_REGION_OMEGA;
+      }
+}
+
+/**
+ * The patches' hexahedra between shells k and k + 1, from element @p e on:
+ * over each face quad of the cube's surface (counterclockwise seen from
+ * outside), shell k's quad is its q1.h bottom face and shell k + 1's its
+ * top face, so det J > 0. On the face normal to axis d at side g_d = 0 or
+ * n, the tangent axes d1, d2 (e_d1 x e_d2 = e_d) are walked in that order
+ * on the + side, reversed on the - side. Returns the next element.
+ */
+static int ball_fill_shell(const ball_grid *b, int k, int e, sp_mesh *mesh) {
+  static const int walk[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const int n = b->n;
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side <= 1; ++side)
+      for (int q = 0; q < n; ++q)
+        for (int p = 0; p < n; ++p, ++e) {
+          const int d1 = (d + 1) % 3, d2 = (d + 2) % 3;
+          int *nodes = mesh->elem + 8 * (size_t)e;
+          for (int a = 0; a < 4; ++a) {
+            const int w = side ? a : (4 - a) % 4; /* reversed: 0, 3, 2, 1 */
+            int corner[3];
+            corner[d] = side ? n : 0;
+            corner[d1] = p + walk[w][0];
+            corner[d2] = q + walk[w][1];
+            nodes[a] = ball_node(b, k, corner);
+            nodes[a + 4] = ball_node(b, k + 1, corner);
+          }
+          mesh->region[e] = k < n ? SP_REGION_OMEGA : SP_REGION_BUFFER;
+        }
+  return e;
+}
+
+/** The cubed ball in its numbering, unit radius, before scaling. */
+static void ball_fill(const ball_grid *b, int buffer_layers, double buffer_width,
+                      sp_mesh *mesh) {
+  ball_fill_nodes(b, buffer_layers, buffer_width, mesh);
+  ball_fill_cube(b, mesh);
+  int e = b->n * b->n * b->n;
+  for (int k = 0; k < b->n_shells; ++k) e = ball_fill_shell(b, k, e, mesh);
+}
+
+long long sp_mesh_ellipsoid_nodes(int refinements, int buffer_layers) {
+  const long long n = 1LL << refinements;
+  return (n + 1) * (n + 1) * (n + 1) + (n + buffer_layers) * ball_shell_nodes(n);
+}
+
+long long sp_mesh_ellipsoid_elements(int refinements, int buffer_layers) {
+  const long long n = 1LL << refinements;
+  return n * n * n + 6 * n * n * (n + buffer_layers);
+}
+
+int sp_mesh_ellipsoid(int refinements, double a, double b, double c, int buffer_layers,
+                      double buffer_width, sp_mesh **out) {
+  SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_ellipsoid: out is NULL");
+  *out = NULL;
+  SP_CALL(check_curved_arguments(refinements, SP_MESH_ELLIPSOID_MAX_REFINEMENTS, 3,
+                                 (double[]){a, b, c}, buffer_layers, buffer_width));
+  /* the nodes, and 8 entries per element, must fit an int */
+  const long long n_nodes = sp_mesh_ellipsoid_nodes(refinements, buffer_layers);
+  const long long n_elems = sp_mesh_ellipsoid_elements(refinements, buffer_layers);
+  SP_CHECK(n_nodes < INT_MAX / 8 && n_elems < INT_MAX / 8, SP_ERR_INPUT,
+           "mesh: refinements = %d with buffer_layers = %d is too large (%lld nodes, %lld "
+           "elements)", refinements, buffer_layers, n_nodes, n_elems);
+
+  const int n = 1 << refinements;
+  ball_grid grid = {n, n + buffer_layers, NULL};
+  const size_t cube_nodes = (size_t)(n + 1) * (n + 1) * (n + 1);
+  SP_ALLOC(grid.surface, cube_nodes);
+  int next = 0, g[3];
+  for (g[2] = 0; g[2] <= n; ++g[2])
+    for (g[1] = 0; g[1] <= n; ++g[1])
+      for (g[0] = 0; g[0] <= n; ++g[0]) {
+        int on_surface = 0;
+        for (int d = 0; d < 3; ++d) on_surface |= g[d] == 0 || g[d] == n;
+        grid.surface[ball_cube_node(n, g)] = on_surface ? next++ : -1;
+      }
+
+  sp_mesh *mesh;
+  const int rc = mesh_allocate(3, (int)n_nodes, (int)n_elems, &mesh);
+  if (rc != SP_OK) {
+    free(grid.surface);
+    return rc;
+  }
+  ball_fill(&grid, buffer_layers, buffer_width, mesh);
+  free(grid.surface);
+  const double scale[3] = {a, b, c};
+  for (size_t i = 0; i < (size_t)n_nodes; ++i)
+    for (int d = 0; d < 3; ++d) mesh->xy[3 * i + d] *= scale[d];
+  mesh->is_ellipse = 1;
+  const double bounds[6] = {0, 0, a, b, 0, c};
+  for (int d = 0; d < 6; ++d) mesh->bounds[d] = bounds[d];
+  mesh_finish(mesh);
+  *out = mesh;
+  return SP_OK;
+}
+
+/* ------------------------------------------------------------------------ */
 /* Queries                                                                  */
 /* ------------------------------------------------------------------------ */
 
@@ -508,17 +735,22 @@ double sp_mesh_region_area(const sp_mesh *mesh, int region) {
   return area;
 }
 
-int sp_mesh_contains(const sp_mesh *mesh, double x, double y) {
-  if (!mesh) return 0; /* (2D: a box's z is not asked) */
+int sp_mesh_contains(const sp_mesh *mesh, const double *x) {
+  if (!mesh) return 0;
+  /* axis d's interval [lo, hi] in bounds (x0, y0, x1, y1, z0, z1) */
+  static const int lo[3] = {0, 1, 4}, hi[3] = {2, 3, 5};
   const double *bd = mesh->bounds;
   if (mesh->is_ellipse) {
-    double u = x / bd[2], v = y / bd[3];
-    return u * u + v * v <= 1 + SP_MESH_CONTAINS_TOL;
+    double level = 0;
+    for (int d = 0; d < mesh->dim; ++d) level += (x[d] / bd[hi[d]]) * (x[d] / bd[hi[d]]);
+    return level <= 1 + SP_MESH_CONTAINS_TOL;
   }
-  double tol_x = SP_MESH_CONTAINS_TOL * (bd[2] - bd[0]);
-  double tol_y = SP_MESH_CONTAINS_TOL * (bd[3] - bd[1]);
-  return x >= bd[0] - tol_x && x <= bd[2] + tol_x && y >= bd[1] - tol_y &&
-         y <= bd[3] + tol_y;
+  int inside = 1;
+  for (int d = 0; d < mesh->dim; ++d) {
+    const double tol = SP_MESH_CONTAINS_TOL * (bd[hi[d]] - bd[lo[d]]);
+    inside &= x[d] >= bd[lo[d]] - tol && x[d] <= bd[hi[d]] + tol;
+  }
+  return inside;
 }
 
 void sp_mesh_destroy(sp_mesh **mesh) {

@@ -2,7 +2,8 @@
  * @file mesh.h
  * @brief Q1 meshes of either dimension (q1.h): quadrilateral rectangles and
  *        the paper's five-patch disk mapped to an ellipse, optionally with a
- *        buffer ring outside Omega (2D), and hexahedral boxes (3D). The
+ *        buffer ring outside Omega (2D), and hexahedral boxes and the cubed
+ *        ball mapped to an ellipsoid, optionally with a buffer shell (3D). The
  *        dimension is the mesh's: code that loops over elements reads
  *        dim and nodes_per_elem from it.
  */
@@ -30,9 +31,11 @@ typedef struct sp_mesh {
   double *xy;       /**< dim * n_nodes coordinates: x, y (and z in 3D) */
   int *elem;        /**< nodes_per_elem * n_elems node indices */
   int *region;      /**< per element: SP_REGION_OMEGA or SP_REGION_BUFFER */
-  int is_ellipse;   /**< 1 for the ellipse mesh, 0 for a rectangle or box */
+  int is_ellipse;   /**< 1 for the ellipse or ellipsoid mesh, 0 for a
+                         rectangle or box */
   double bounds[6]; /**< Omega: rectangle x0, y0, x1, y1; ellipse 0, 0, a, b;
-                         box x0, y0, x1, y1, z0, z1 */
+                         box x0, y0, x1, y1, z0, z1; ellipsoid 0, 0, a, b,
+                         0, c */
   double h;         /**< largest element edge length */
   /** The Q1 geometry at element e's Gauss point q (sp_q1_point), made once
    *  with the mesh so that loops over elements (src/cells.c) need not
@@ -70,6 +73,31 @@ int sp_mesh_ellipse(int refinements, double a, double b, int buffer_layers,
 int sp_mesh_box(double x0, double y0, double z0, double x1, double y1, double z1, int nx,
                 int ny, int nz, sp_mesh **out);
 
+/** Largest refinement of sp_mesh_ellipsoid: r = 7 has 14.7e6 hexahedra. */
+#define SP_MESH_ELLIPSOID_MAX_REFINEMENTS 7
+
+/**
+ * @brief The cubed ball (a centre cube and six patches to the sphere, the 3D
+ *        twin of sp_mesh_ellipse's five-patch disk) refined @p refinements
+ *        times, mapped to the ellipsoid with semi-axes @p a (x), @p b (y),
+ *        @p c (z) centred at the origin: with n = 2^refinements, n^3 cube
+ *        hexahedra and 6 n^3 in the patches (r = 3: 3584 elements, 3817
+ *        nodes). With @p buffer_layers > 0, that many shells of 6 n^2
+ *        hexahedra of total radial width @p buffer_width (a fraction of the
+ *        semi-axes) are added outside, with region SP_REGION_BUFFER.
+ * @param[out] out the new mesh (destroy with sp_mesh_destroy)
+ * @return SP_OK or an error code with a message
+ */
+int sp_mesh_ellipsoid(int refinements, double a, double b, double c, int buffer_layers,
+                      double buffer_width, sp_mesh **out);
+
+/** @brief The number of nodes sp_mesh_ellipsoid makes, (n+1)^3 + (n + L)(6n^2 + 2)
+ *         with n = 2^refinements and L = buffer_layers, without building the mesh. */
+long long sp_mesh_ellipsoid_nodes(int refinements, int buffer_layers);
+
+/** @brief The number of elements sp_mesh_ellipsoid makes, n^3 + 6n^2 (n + L). */
+long long sp_mesh_ellipsoid_elements(int refinements, int buffer_layers);
+
 /** @brief The number of nodes sp_mesh_box makes, (nx+1)(ny+1)(nz+1). */
 long long sp_mesh_box_nodes(int nx, int ny, int nz);
 
@@ -85,8 +113,9 @@ long long sp_mesh_ellipse_nodes(int refinements, int buffer_layers);
  *         (the Gauss rule of q1.h). */
 double sp_mesh_region_area(const sp_mesh *mesh, int region);
 
-/** @brief 1 if (x, y) lies in Omega (closed), else 0. */
-int sp_mesh_contains(const sp_mesh *mesh, double x, double y);
+/** @brief 1 if the point @p x (mesh->dim coordinates) lies in Omega
+ *         (closed, to a relative 1e-12), else 0. */
+int sp_mesh_contains(const sp_mesh *mesh, const double *x);
 
 /** @brief Free the mesh and set *mesh to NULL. */
 void sp_mesh_destroy(sp_mesh **mesh);

@@ -81,7 +81,7 @@ static int record_energy(sp_run *run, double dt, int its, const sp_step_costs *c
 }
 
 /** The fields of the state: a piece per rank and the .pvtu by rank 0 under
- *  MPI, else one .vtu (2D meshes: VTU hexahedra are issue 29's next phase). */
+ *  MPI, else one .vtu. */
 static int write_fields(sp_run *run) {
   sp_monitor *mon = &run->mon;
   if (run->n_ranks > 1) {
@@ -99,12 +99,12 @@ static int write_fields(sp_run *run) {
   return sp_output_fields(mon->output, run->mesh, run->layout, run->state, run->step, run->t);
 }
 
-/** The fields of the state (on a 2D mesh), its picture (output.pictures)
+/** The fields of the state, its picture (output.pictures)
  *  and energy.png. */
 static int write_snapshot(sp_run *run) {
   sp_monitor *mon = &run->mon;
   SP_CALL(sp_fault_check(SP_FAULT_OUTPUT, run->rank));
-  if (run->mesh->dim == 2) SP_CALL(write_fields(run));
+  SP_CALL(write_fields(run));
   if (run->rank != 0) return SP_OK;
   char path[4096];
   if (run->opt.output.pictures) {
@@ -129,8 +129,8 @@ int sp_monitor_open(sp_run *run) {
   if (run->rank == 0) {
     if (run->restarted) { /* the logs cut back to the checkpoint's step */
       sp_checkpoint_remove_after(mon->out_dir, run->step);
-      rc = sp_output_resume(mon->out_dir, run->step, run->lineage.named, mon->n_fields,
-                            mon->fields, &mon->output);
+      rc = sp_output_resume(mon->out_dir, run->mesh->dim, run->step, run->lineage.named,
+                            mon->n_fields, mon->fields, &mon->output);
     } else {
       rc = sp_output_open_dim(mon->out_dir, run->mesh->dim, run->lineage.named, &mon->output);
     }
@@ -297,13 +297,6 @@ static int checkpoint_if_due(sp_run *run, int *signalled) {
   if (!(want_stop || want_time ||
         (o->checkpoint_every > 0 && run->step % o->checkpoint_every == 0)))
     return SP_OK;
-  if (run->mesh->dim != 2) { /* no checkpoints in 3D yet: a signal stops the run alone */
-    if (want_stop) atomic_store(&stop_requested, 0);
-    if (want_stop && run->rank == 0)
-      fprintf(stderr, "softpack: stopped on a signal after step %d (t = %.6g): no checkpoint "
-              "(not yet on a 3D mesh)\n", run->step, run->t);
-    return SP_OK;
-  }
   char path[4096] = "";
   const double t0 = sp_wall_clock();
   int rc = SP_OK;

@@ -530,6 +530,9 @@ static int32_t sp_node_cell_id(const sp_layout *l, const double *state,
   return id;
 }
 
+/** VTK's cell types (vtkCellType.h). */
+enum { SP_VTK_QUAD = 9, SP_VTK_HEXAHEDRON = 12 };
+
 /** The points and elements of one .vtu: all of the mesh, or (a piece of
  *  an MPI run) a subset of the elements and the nodes they use. */
 typedef struct {
@@ -614,26 +617,29 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
   sp_vtu_array_close(f);
   fprintf(f, "      </CellData>\n");
 
-  /* Points: 3 components, z = 0 (ParaView wants 3D points). */
+  /* Points: 3 components (ParaView wants 3D points; z = 0 in 2D). */
+  const int dim = mesh->dim, nen = mesh->nodes_per_elem;
   fprintf(f, "      <Points>\n");
   sp_vtu_array_open(f, "Float64", "Points", 3);
   sp_b64_begin_array(&b, f, (uint64_t)nn * 3 * sizeof(double));
   for (int j = 0; j < nn; ++j) {
-    const int i = part_node(part, j);
-    double x[3] = {mesh->xy[2 * i], mesh->xy[2 * i + 1], 0.0};
+    const double *xi = mesh->xy + (size_t)dim * part_node(part, j);
+    double x[3] = {xi[0], xi[1], dim == 3 ? xi[2] : 0.0};
     sp_b64_put(&b, x, sizeof x);
   }
   sp_b64_end(&b);
   sp_vtu_array_close(f);
   fprintf(f, "      </Points>\n");
 
-  /* Cells: the quads as listed (counterclockwise, as VTK_QUAD wants). */
+  /* Cells: the elements' nodes as listed: q1.h's order is VTK's, for
+   * VTK_QUAD (counterclockwise) and VTK_HEXAHEDRON (the bottom face
+   * counterclockwise seen from the top face, then the top face). */
   fprintf(f, "      <Cells>\n");
   sp_vtu_array_open(f, "Int32", "connectivity", 1);
-  sp_b64_begin_array(&b, f, (uint64_t)ne * 4 * sizeof(int32_t));
+  sp_b64_begin_array(&b, f, (uint64_t)ne * nen * sizeof(int32_t));
   for (int j = 0; j < ne; ++j)
-    for (int a = 0; a < 4; ++a) {
-      const int node = mesh->elem[4 * part_elem(part, j) + a];
+    for (int a = 0; a < nen; ++a) {
+      const int node = mesh->elem[(size_t)nen * part_elem(part, j) + a];
       int32_t n = part->local ? part->local[node] : node;
       sp_b64_put(&b, &n, sizeof n);
     }
@@ -642,16 +648,16 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
   sp_vtu_array_open(f, "Int64", "offsets", 1);
   sp_b64_begin_array(&b, f, (uint64_t)ne * sizeof(int64_t));
   for (int e = 0; e < ne; ++e) {
-    int64_t off = 4 * ((int64_t)e + 1);
+    int64_t off = nen * ((int64_t)e + 1);
     sp_b64_put(&b, &off, sizeof off);
   }
   sp_b64_end(&b);
   sp_vtu_array_close(f);
   sp_vtu_array_open(f, "UInt8", "types", 1);
   sp_b64_begin_array(&b, f, (uint64_t)ne);
+  const uint8_t vtk_type = dim == 3 ? SP_VTK_HEXAHEDRON : SP_VTK_QUAD;
   for (int e = 0; e < ne; ++e) {
-    const uint8_t vtk_quad = 9;
-    sp_b64_put(&b, &vtk_quad, 1);
+    sp_b64_put(&b, &vtk_type, 1);
   }
   sp_b64_end(&b);
   sp_vtu_array_close(f);
@@ -706,8 +712,6 @@ static int sp_fields_record(struct sp_output_s *o, int step, double t, int pvtu)
 int sp_output_fields(sp_output out, const sp_mesh *mesh,
                      const sp_layout *layout, const double *state, int step,
                      double t) {
-  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
-           "output: the VTU fields are not yet on a 3D mesh (issue 29)");
   SP_CHECK(mesh->n_nodes == layout->n_nodes, SP_ERR_INTERNAL,
            "output: mesh has %d nodes but layout has %d", mesh->n_nodes,
            layout->n_nodes);
@@ -732,8 +736,6 @@ int sp_output_fields(sp_output out, const sp_mesh *mesh,
 int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout *layout,
                            const double *state, int step, double t, int rank,
                            int first_node, int end_node) {
-  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
-           "output: the VTU fields are not yet on a 3D mesh (issue 29)");
   SP_CHECK(mesh->n_nodes == layout->n_nodes && first_node >= 0 && first_node <= end_node &&
            end_node <= mesh->n_nodes && step >= 0 && rank >= 0, SP_ERR_INTERNAL,
            "output piece: nodes %d..%d of %d (layout %d), step %d, rank %d", first_node,
@@ -744,11 +746,12 @@ int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout
   int *elems = block, *nodes = block + ne, *local = block + ne + nn;
   int n_elems = 0, n_nodes = 0;
   for (size_t i = 0; i < nn; ++i) local[i] = -1;
+  const int nen = mesh->nodes_per_elem;
   for (size_t e = 0; e < ne; ++e) {
-    const int *en = mesh->elem + 4 * e;
+    const int *en = mesh->elem + (size_t)nen * e;
     if (en[0] < first_node || en[0] >= end_node) continue; /* the solver's rule */
     elems[n_elems++] = (int)e;
-    for (int a = 0; a < 4; ++a) local[en[a]] = 0;
+    for (int a = 0; a < nen; ++a) local[en[a]] = 0;
   }
   for (size_t i = 0; i < nn; ++i)
     if (local[i] == 0) {
@@ -806,9 +809,10 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
   return sp_pvd_write(out);
 }
 
-int sp_output_resume(const char *dir, int step, int named, int n_fields,
+int sp_output_resume(const char *dir, int dim, int step, int named, int n_fields,
                      const sp_output_field *fields, sp_output *out) {
-  SP_CALL(output_open(dir, 2, named, step, out)); /* (checkpoints are 2D) */
+  SP_CHECK(dim == 2 || dim == 3, SP_ERR_INTERNAL, "output: dimension %d", dim);
+  SP_CALL(output_open(dir, dim, named, step, out));
   for (int i = 0; i < n_fields; ++i)
     if (fields[i].step <= step) {
       int rc = sp_fields_record(*out, fields[i].step, fields[i].t, fields[i].pvtu);

@@ -43,9 +43,10 @@ typedef struct {
  * @brief Continue a run in @p dir from its step @p step (a restart): the
  *        CSV logs are cut back to the rows of steps <= @p step (and a torn
  *        last line) and appended to; fields.pvd lists @p fields up to
- *        @p step. Logs that do not exist are started with their headers.
+ *        @p step. Logs that do not exist are started with their headers
+ *        (cells.csv's for a mesh of dimension @p dim, as sp_output_open_dim).
  */
-int sp_output_resume(const char *dir, int step, int named, int n_fields,
+int sp_output_resume(const char *dir, int dim, int step, int named, int n_fields,
                      const sp_output_field *fields, sp_output *out);
 
 /** What sp_vtu_read finds in a softpack .vtu: the points (x, y) and every
@@ -105,7 +106,8 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
                     const sp_cell_obs *obs, const sp_cell_name *names);
 
 /**
- * @brief Write fields_<step>.vtu (unstructured grid of quads; point arrays
+ * @brief Write fields_<step>.vtu (unstructured grid of the mesh's elements,
+ *        quads (VTK type 9) in 2D, hexahedra (type 12) in 3D; point arrays
  *        c_k and mu_k per cell, 0 outside a cell's support, and cell_id = the
  *        k (from 1) with the largest c_k where that c_k > 1/2, else 0) and
  *        rewrite fields.pvd listing every .vtu written so far with its time.

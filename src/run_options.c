@@ -7,6 +7,9 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
     return sp_mesh_rectangle(m->x0, m->y0, m->x1, m->y1, m->nx, m->ny, out);
   if (m->type == SP_MESH_BOX)
     return sp_mesh_box(m->x0, m->y0, m->z0, m->x1, m->y1, m->z1, m->nx, m->ny, m->nz, out);
+  if (m->type == SP_MESH_ELLIPSOID)
+    return sp_mesh_ellipsoid(m->refinements, m->semi_x, m->semi_y, m->semi_z, m->buffer_layers,
+                             m->buffer_width, out);
   return sp_mesh_ellipse(m->refinements, m->semi_x, m->semi_y, m->buffer_layers,
                          m->buffer_width, out);
 }

@@ -160,7 +160,8 @@ typedef struct {
 } sp_key;
 
 static const cyaml_strval_t sp_mesh_words[] = {
-    {"rectangle", SP_MESH_RECTANGLE}, {"ellipse", SP_MESH_ELLIPSE}, {"box", SP_MESH_BOX}};
+    {"rectangle", SP_MESH_RECTANGLE}, {"ellipse", SP_MESH_ELLIPSE}, {"box", SP_MESH_BOX},
+    {"ellipsoid", SP_MESH_ELLIPSOID}};
 static const cyaml_strval_t sp_profile_words[] = {
     {"tanh", SP_PROFILE_TANH}, {"sharp", SP_PROFILE_SHARP}};
 static const cyaml_strval_t sp_jacobian_words[] = {
@@ -272,8 +273,8 @@ static const sp_key sp_keys[] = {
     /* mesh */
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
              "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
-             "of hexahedra (3D; not yet with divisions, the shape term, local "
-             "supports, checkpoints, initial files, fields or pictures: issue 29)"),
+             "or an ellipsoid of hexahedra (3D; not yet with divisions, the shape "
+             "term, local supports, initial files or pictures: issue 29)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
               "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
@@ -295,18 +296,22 @@ static const sp_key sp_keys[] = {
     KEY_INT(SP_SEC_MESH, "refinements", mesh.refinements, 5, AT_LEAST(0),
             AT_MOST(9), "-",
             "ellipse: uniform refinements of the five-patch disk "
-            "(5: the paper's 5120 elements)"),
+            "(5: the paper's 5120 elements); ellipsoid: of the cubed ball, at "
+            "most 7 (4: 28672 elements)"),
     KEY_FLOAT(SP_SEC_MESH, "semi_x", mesh.semi_x, 0.5, ABOVE(0.0), UNBOUNDED,
-              "L", "ellipse: semi-axis along x (centred at the origin)"),
+              "L", "ellipse, ellipsoid: semi-axis along x (centred at the origin)"),
     KEY_FLOAT(SP_SEC_MESH, "semi_y", mesh.semi_y, 0.25, ABOVE(0.0), UNBOUNDED,
-              "L", "ellipse: semi-axis along y"),
+              "L", "ellipse, ellipsoid: semi-axis along y"),
+    KEY_FLOAT(SP_SEC_MESH, "semi_z", mesh.semi_z, NAN, ABOVE(0.0), UNBOUNDED,
+              "L", "ellipsoid: semi-axis along z (required there; not allowed on "
+              "other meshes)"),
     KEY_INT(SP_SEC_MESH, "buffer_layers", mesh.buffer_layers, 0, AT_LEAST(0),
             AT_MOST(64), "elements",
-            "ellipse: element rings of the buffer zone outside Omega "
-            "(0: no buffer)"),
+            "ellipse, ellipsoid: element rings (shells) of the buffer zone outside "
+            "Omega (0: no buffer)"),
     KEY_FLOAT(SP_SEC_MESH, "buffer_width", mesh.buffer_width, 0.1, ABOVE(0.0),
               AT_MOST(1.0), "-",
-              "ellipse: radial width of the buffer as a fraction of the "
+              "ellipse, ellipsoid: radial width of the buffer as a fraction of the "
               "semi-axes"),
     /* model */
     KEY_FLOAT(SP_SEC_MODEL, "alpha", model.alpha, 4.0, ABOVE(0.0), UNBOUNDED,
@@ -594,8 +599,8 @@ static const sp_key sp_keys[] = {
     CELL_FLOAT_REQUIRED("y", y, UNBOUNDED, UNBOUNDED, "L",
                         "centre y; the cell's disk must lie inside Omega"),
     CELL_FLOAT("z", z, NAN, UNBOUNDED, UNBOUNDED, "L",
-               "centre z: required on a 3D mesh (mesh.type box), where the cell is "
-               "a sphere inside the box; not allowed on a 2D one"),
+               "centre z: required on a 3D mesh (mesh.type box, ellipsoid), where the "
+               "cell is a sphere inside Omega; not allowed on a 2D one"),
     CELL_FLOAT_REQUIRED("radius", radius, ABOVE(0.0), UNBOUNDED, "L",
                         "radius of the c = 1/2 level set"),
     CELL_FLOAT("semi_x", semi_x, NAN, ABOVE(0.0), UNBOUNDED, "L",
@@ -1482,6 +1487,26 @@ static int check_initial(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
+/** mesh.semi_z given on an ellipsoid (and only there), its refinements at
+ *  most SP_MESH_ELLIPSOID_MAX_REFINEMENTS. */
+static int check_ellipsoid_keys(const sp_scene_mesh *m, const char *file) {
+  if (m->type == SP_MESH_ELLIPSOID) {
+    SP_CHECK(!isnan(m->semi_z), SP_ERR_INPUT,
+             "%s: mesh.semi_z: required with mesh.type ellipsoid: expected the semi-axis "
+             "along z, a number > 0", file);
+    SP_CHECK(m->refinements <= SP_MESH_ELLIPSOID_MAX_REFINEMENTS, SP_ERR_INPUT,
+             "%s: mesh.refinements: expected at most %d with mesh.type ellipsoid (%d gives "
+             "%lld hexahedra), got %d", file, SP_MESH_ELLIPSOID_MAX_REFINEMENTS,
+             m->refinements, sp_mesh_ellipsoid_elements(m->refinements, m->buffer_layers),
+             m->refinements);
+  } else {
+    SP_CHECK(isnan(m->semi_z), SP_ERR_INPUT,
+             "%s: mesh.semi_z: only with mesh.type ellipsoid, got %.15g with mesh.type %s",
+             file, m->semi_z, sp_mesh_words[m->type].str);
+  }
+  return SP_OK;
+}
+
 static int check_time_and_mesh(const sp_scene *scene, const char *file) {
   const sp_scene_time *t = &scene->time;
   SP_CHECK(t->dt_min <= t->dt, SP_ERR_INPUT,
@@ -1520,16 +1545,15 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
              "%s: mesh.z1: expected a number > mesh.z0 = %.15g, got %.15g",
              file, m->z0, m->z1);
   }
-  return SP_OK;
+  return check_ellipsoid_keys(&scene->mesh, file);
 }
 
 /** Why a 3D scene cannot have a feature yet (issue 29's later phases). */
-#define SP_NOT_YET_3D "not yet in 3D (mesh.type box; issue 29)"
+#define SP_NOT_YET_3D "not yet in 3D (mesh.type box, ellipsoid; issue 29)"
 
 /** What a scene on a 3D mesh cannot ask for yet, each refused naming its
- *  key, rather than run wrong: the shape term, local supports, pictures,
- *  checkpoints and initial fields from files (the VTU fields are not
- *  written in 3D: no key asks for them). */
+ *  key, rather than run wrong: the shape term, local supports, pictures
+ *  and initial fields from files. */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
   SP_CHECK(scene->n_lineage == 0, SP_ERR_INPUT,
@@ -1559,12 +1583,6 @@ static int check_3d(const sp_scene *scene, const char *file) {
            file, max_cells);
   SP_CHECK(!scene->output.pictures, SP_ERR_INPUT,
            "%s: output.pictures: pictures are " SP_NOT_YET_3D ": expected false", file);
-  SP_CHECK(scene->output.checkpoint_every == 0, SP_ERR_INPUT,
-           "%s: output.checkpoint_every: checkpoints are " SP_NOT_YET_3D ": expected 0, got %d",
-           file, scene->output.checkpoint_every);
-  SP_CHECK(scene->output.checkpoint_seconds == 0, SP_ERR_INPUT,
-           "%s: output.checkpoint_seconds: checkpoints are " SP_NOT_YET_3D
-           ": expected 0, got %.15g", file, scene->output.checkpoint_seconds);
   SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
            "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
            ": expected none, got '%s'", file, scene->initial.from);
@@ -1582,13 +1600,53 @@ static const char *extent_key(const sp_scene_cell *c, int d) {
   return isnan(given[d]) ? "radius" : semi[d];
 }
 
-/** Every cell's centre, and its whole sphere (ellipsoid), inside the box;
- *  its z given. */
+/** Points on a cell's sphere tested against the ellipsoid: latitude
+ *  circles of SP_DISK_CHECK_ANGLES points, half as many latitudes. */
+enum { SP_SPHERE_CHECK_LATITUDES = SP_DISK_CHECK_ANGLES / 2 };
+
+/** (x/a)^2 + (y/b)^2 + (z/c)^2: <= 1 inside the ellipsoid of the mesh. */
+static double ellipsoid_level(const sp_scene_mesh *m, const double x[3]) {
+  const double semi[3] = {m->semi_x, m->semi_y, m->semi_z};
+  double level = 0;
+  for (int d = 0; d < 3; ++d) level += (x[d] / semi[d]) * (x[d] / semi[d]);
+  return level;
+}
+
+/** Cell @p i's centre, and its whole sphere (or ellipsoid: its semi-axes),
+ *  inside the ellipsoid. */
+static int check_sphere_in_ellipsoid(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
+                                     const char *file) {
+  const double centre[3] = {c->x, c->y, c->z}, r = c->radius;
+  const double level = ellipsoid_level(m, centre);
+  SP_CHECK(level <= 1.0, SP_ERR_INPUT,
+           "%s: cells[%d].x, cells[%d].y, cells[%d].z: the centre (%.15g, %.15g, %.15g) is "
+           "outside the ellipsoid (x/%.15g)^2 + (y/%.15g)^2 + (z/%.15g)^2 <= 1 (it gives %.6g)",
+           file, i, i, i, c->x, c->y, c->z, m->semi_x, m->semi_y, m->semi_z, level);
+  const double half_turn = acos(-1.0);
+  for (int la = 0; la <= SP_SPHERE_CHECK_LATITUDES; ++la)
+    for (int j = 0; j < SP_DISK_CHECK_ANGLES; ++j) {
+      const double polar = half_turn * la / SP_SPHERE_CHECK_LATITUDES;
+      const double azimuth = 2 * half_turn * j / SP_DISK_CHECK_ANGLES;
+      const double p[3] = {c->x + sp_scene_cell_semi_axis(c, 0) * sin(polar) * cos(azimuth),
+                           c->y + sp_scene_cell_semi_axis(c, 1) * sin(polar) * sin(azimuth),
+                           c->z + sp_scene_cell_semi_axis(c, 2) * cos(polar)};
+      SP_CHECK(ellipsoid_level(m, p) <= 1.0, SP_ERR_INPUT,
+               "%s: cells[%d].radius: the sphere (or semi-axes) of radius %.15g around (%.15g, "
+               "%.15g, %.15g) is not inside the ellipsoid with semi-axes (%.15g, %.15g, %.15g): its point "
+               "(%.6g, %.6g, %.6g) is outside",
+               file, i, r, c->x, c->y, c->z, m->semi_x, m->semi_y, m->semi_z, p[0], p[1], p[2]);
+    }
+  return SP_OK;
+}
+
+/** Every cell's centre, and its whole sphere (ellipsoid), inside the box
+ *  or the ellipsoid; its z given. */
 static int check_sphere(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
                         const char *file) {
   SP_CHECK(!isnan(c->z), SP_ERR_INPUT,
-           "%s: cells[%d].z: required on a 3D mesh (mesh.type box): the cell is a sphere", file,
-           i);
+           "%s: cells[%d].z: required on a 3D mesh (mesh.type %s): the cell is a sphere", file,
+           i, sp_mesh_words[m->type].str);
+  if (m->type == SP_MESH_ELLIPSOID) return check_sphere_in_ellipsoid(m, c, i, file);
   const double lo[3] = {m->x0, m->y0, m->z0}, hi[3] = {m->x1, m->y1, m->z1};
   const double x[3] = {c->x, c->y, c->z}, r = c->radius;
   static const char *const name[3] = {"x", "y", "z"};
@@ -1690,17 +1748,18 @@ static int check_cells(const sp_scene *scene, const char *file) {
   const sp_scene_mesh *m = &scene->mesh;
   for (int i = 0; i < scene->n_cells; ++i) {
     const sp_scene_cell *c = &scene->cells[i];
-    if (m->type == SP_MESH_BOX) {
+    if (sp_scene_dim(scene) == 3) {
       SP_CALL(check_sphere(m, c, i, file));
       continue;
     }
     SP_CHECK(isnan(c->z), SP_ERR_INPUT,
-             "%s: cells[%d].z: only on a 3D mesh (mesh.type box), got %.15g with mesh.type %s",
-             file, i, c->z, m->type == SP_MESH_RECTANGLE ? "rectangle" : "ellipse");
-    SP_CHECK(isnan(c->semi_z), SP_ERR_INPUT,
-             "%s: cells[%d].semi_z: only on a 3D mesh (mesh.type box), got %.15g with "
+             "%s: cells[%d].z: only on a 3D mesh (mesh.type box, ellipsoid), got %.15g with "
              "mesh.type %s",
-             file, i, c->semi_z, m->type == SP_MESH_RECTANGLE ? "rectangle" : "ellipse");
+             file, i, c->z, sp_mesh_words[m->type].str);
+    SP_CHECK(isnan(c->semi_z), SP_ERR_INPUT,
+             "%s: cells[%d].semi_z: only on a 3D mesh (mesh.type box, ellipsoid), got %.15g "
+             "with mesh.type %s",
+             file, i, c->semi_z, sp_mesh_words[m->type].str);
     if (m->type == SP_MESH_RECTANGLE) SP_CALL(check_disk_in_rectangle(m, c, i, file));
     else SP_CALL(check_disk_in_ellipse(m, c, i, file));
   }
@@ -1840,9 +1899,11 @@ static int check_lineage(const sp_scene *scene, const char *file) {
 static int check_sizes(const sp_scene *scene, const char *file) {
   const sp_scene_mesh *m = &scene->mesh;
   const int rectangle = m->type == SP_MESH_RECTANGLE, box = m->type == SP_MESH_BOX;
+  const int ellipsoid = m->type == SP_MESH_ELLIPSOID;
   const long long nodes = rectangle ? sp_mesh_rectangle_nodes(m->nx, m->ny)
                           : box     ? sp_mesh_box_nodes(m->nx, m->ny, m->nz)
-                                    : sp_mesh_ellipse_nodes(m->refinements, m->buffer_layers);
+                          : ellipsoid ? sp_mesh_ellipsoid_nodes(m->refinements, m->buffer_layers)
+                                      : sp_mesh_ellipse_nodes(m->refinements, m->buffer_layers);
   const long long pairs = nodes * scene->n_cells;
   char mesh_keys[SP_TEXT];
   if (rectangle)
@@ -1913,7 +1974,9 @@ int sp_scene_cell_is_ellipsoid(const sp_scene_cell *cell) {
   return !isnan(cell->semi_x) || !isnan(cell->semi_y) || !isnan(cell->semi_z);
 }
 
-int sp_scene_dim(const sp_scene *scene) { return scene->mesh.type == SP_MESH_BOX ? 3 : 2; }
+int sp_scene_dim(const sp_scene *scene) {
+  return scene->mesh.type == SP_MESH_BOX || scene->mesh.type == SP_MESH_ELLIPSOID ? 3 : 2;
+}
 
 int sp_scene_read_file(const char *path, char **text, size_t *len) {
   return read_file(path, text, len);

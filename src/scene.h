@@ -18,8 +18,13 @@
 extern "C" {
 #endif
 
-/** The domain: 2D rectangle or ellipse, 3D box (hexahedra). */
-typedef enum { SP_MESH_RECTANGLE = 0, SP_MESH_ELLIPSE = 1, SP_MESH_BOX = 2 } sp_mesh_kind;
+/** The domain: 2D rectangle or ellipse, 3D box or ellipsoid (hexahedra). */
+typedef enum {
+  SP_MESH_RECTANGLE = 0,
+  SP_MESH_ELLIPSE = 1,
+  SP_MESH_BOX = 2,
+  SP_MESH_ELLIPSOID = 3
+} sp_mesh_kind;
 typedef enum { SP_PROFILE_TANH = 0, SP_PROFILE_SHARP = 1 } sp_profile_kind;
 typedef enum { SP_JAC_AD = 0, SP_JAC_HAND = 1, SP_JAC_FD = 2 } sp_jacobian_kind;
 /** Newton's initial guess: the last state, or extrapolated from the last two. */
@@ -40,15 +45,19 @@ typedef enum {
 
 /** mesh: the domain and its discretisation. */
 typedef struct {
-  sp_mesh_kind type;   /**< rectangle | ellipse | box */
+  sp_mesh_kind type;   /**< rectangle | ellipse | box | ellipsoid */
   double x0, y0, x1, y1; /**< rectangle (and box) corners */
   int nx, ny;          /**< rectangle (and box) elements per direction */
   double z0, z1;       /**< box: bottom and top */
   int nz;              /**< box: elements along z */
-  int refinements;     /**< ellipse: five-patch disk refined r times */
-  double semi_x, semi_y; /**< ellipse semi-axes (x, y) */
-  int buffer_layers;   /**< ellipse: element rings of the buffer (0 = none) */
-  double buffer_width; /**< ellipse: buffer width as a fraction of the axes */
+  int refinements;     /**< ellipse (ellipsoid): five-patch disk (cubed
+                            ball) refined r times */
+  double semi_x, semi_y; /**< ellipse (and ellipsoid) semi-axes (x, y) */
+  double semi_z;       /**< ellipsoid: semi-axis z (NaN: not given) */
+  int buffer_layers;   /**< ellipse, ellipsoid: element rings (shells) of the
+                            buffer (0 = none) */
+  double buffer_width; /**< ellipse, ellipsoid: buffer width as a fraction
+                            of the axes */
 } sp_scene_mesh;
 
 /** model: the energy and the dynamics (paper table 1). */
@@ -290,7 +299,8 @@ int sp_scene_first_difference(const sp_scene *a, const sp_scene *b,
  *         without the NUL), for sp_scene_load_text. */
 int sp_scene_read_file(const char *path, char **text, size_t *len);
 
-/** @brief The dimension of the scene's mesh: 3 for mesh.type box, else 2. */
+/** @brief The dimension of the scene's mesh: 3 for mesh.type box and
+ *         ellipsoid, else 2. */
 int sp_scene_dim(const sp_scene *scene);
 
 /** @brief Interface width d = sqrt(kappa / (2 alpha)) of the scene's model. */

@@ -9,7 +9,7 @@
  *     part to 1e-9 of the total), cell masses to 1e-10 relative, the same
  *     rows of contacts.csv with contacts and surfaces to 1e-9 relative; with
  *     P > 1, the .pvtu pieces cover the mesh once and hold the one-process
- *     fields (compare_fields; 2D scenes: a 3D run writes no fields yet).
+ *     fields (compare_fields; 2D and 3D scenes).
  *
  *   mpi_compare iterates LINEAR...
  *     The first Newton iterates of one step (three touching cells, 40 x 40
@@ -270,7 +270,7 @@ static int cmd_steps(int argc, char **argv, int rank, int size) {
     printf("%d processes: %d steps, %.1f s\n", size, sum_par.steps, MPI_Wtime() - t0);
     CHECK(sum_ref.steps == sum_par.steps, "%d vs %d steps", sum_ref.steps, sum_par.steps);
     compare_runs(ref, par, scene->division.criterion != SP_DIVIDE_NONE);
-    if (size > 1 && sp_scene_dim(scene) == 2) compare_fields(ref, par, size); /* 3D: no fields yet */
+    if (size > 1) compare_fields(ref, par, size);
   }
   sp_scene_destroy(&scene);
   return 0;

@@ -159,11 +159,11 @@ static void test_rectangle_counts_area_and_numbering(void) {
 static void test_rectangle_contains(void) {
   sp_mesh *m = NULL;
   CHECK_OK(sp_mesh_rectangle(0, 0, 2, 1, 4, 2, &m));
-  CHECK(sp_mesh_contains(m, 0, 0) == 1, "corner (0,0) is in Omega");
-  CHECK(sp_mesh_contains(m, 2, 1) == 1, "corner (2,1) is in Omega");
-  CHECK(sp_mesh_contains(m, 1, 0.5) == 1, "centre is in Omega");
-  CHECK(sp_mesh_contains(m, 2.001, 0.5) == 0, "x > x1 is outside");
-  CHECK(sp_mesh_contains(m, 1, -0.001) == 0, "y < y0 is outside");
+  CHECK(sp_mesh_contains(m, (double[]){0, 0}) == 1, "corner (0,0) is in Omega");
+  CHECK(sp_mesh_contains(m, (double[]){2, 1}) == 1, "corner (2,1) is in Omega");
+  CHECK(sp_mesh_contains(m, (double[]){1, 0.5}) == 1, "centre is in Omega");
+  CHECK(sp_mesh_contains(m, (double[]){2.001, 0.5}) == 0, "x > x1 is outside");
+  CHECK(sp_mesh_contains(m, (double[]){1, -0.001}) == 0, "y < y0 is outside");
   sp_mesh_destroy(&m);
 }
 
@@ -272,7 +272,7 @@ static void test_ellipse_boundary_nodes_lie_on_the_ellipse(void) {
     for (int i = 0; i < m->n_nodes; ++i) {
       double level = ellipse_level(m, i);
       on += fabs(level - 1) < 1e-14;
-      outside += !sp_mesh_contains(m, m->xy[2 * i], m->xy[2 * i + 1]);
+      outside += !sp_mesh_contains(m, m->xy + 2 * i);
     }
     CHECK(on == 4 << r, "r = %d: %d nodes on the ellipse, want 4n = %d", r,
           on, 4 << r);
@@ -347,7 +347,7 @@ static void test_buffer_ring(void) {
     for (int i = 0; i < m->n_nodes; ++i) {
       double level = ellipse_level(m, i);
       outer += fabs(level - (1 + width) * (1 + width)) < 1e-13;
-      inside += sp_mesh_contains(m, m->xy[2 * i], m->xy[2 * i + 1]);
+      inside += sp_mesh_contains(m, m->xy + 2 * i);
     }
     CHECK(outer == 4 * n, "r = %d: %d nodes on the outer buffer boundary", r,
           outer);
@@ -379,13 +379,13 @@ static void test_h_halves_with_refinement(void) {
 static void test_ellipse_contains(void) {
   sp_mesh *m = NULL;
   CHECK_OK(sp_mesh_ellipse(1, 0.5, 0.25, 0, 0, &m));
-  CHECK(sp_mesh_contains(m, 0, 0) == 1, "centre");
-  CHECK(sp_mesh_contains(m, 0.5, 0) == 1, "end of the x semi-axis");
-  CHECK(sp_mesh_contains(m, 0, -0.25) == 1, "end of the y semi-axis");
-  CHECK(sp_mesh_contains(m, 0.5 * cos(1.0), 0.25 * sin(1.0)) == 1,
+  CHECK(sp_mesh_contains(m, (double[]){0, 0}) == 1, "centre");
+  CHECK(sp_mesh_contains(m, (double[]){0.5, 0}) == 1, "end of the x semi-axis");
+  CHECK(sp_mesh_contains(m, (double[]){0, -0.25}) == 1, "end of the y semi-axis");
+  CHECK(sp_mesh_contains(m, (double[]){0.5 * cos(1.0), 0.25 * sin(1.0)}) == 1,
         "a point on the ellipse");
-  CHECK(sp_mesh_contains(m, 0.5001, 0) == 0, "beyond the x semi-axis");
-  CHECK(sp_mesh_contains(m, 0.36, 0.18) == 0, "outside near the diagonal");
+  CHECK(sp_mesh_contains(m, (double[]){0.5001, 0}) == 0, "beyond the x semi-axis");
+  CHECK(sp_mesh_contains(m, (double[]){0.36, 0.18}) == 0, "outside near the diagonal");
   sp_mesh_destroy(&m);
 }
 

@@ -1,12 +1,15 @@
-/* Scenes on a 3D mesh (mesh.type box, issue 29 phase 1):
+/* Scenes on a 3D mesh (mesh.type box, ellipsoid; issue 29):
  *  - a box scene with spheres loads: dimension 3, the cells' z, the box's
- *    z0, z1, nz;
+ *    z0, z1, nz; so does an ellipsoid scene (semi_z);
+ *  - an ellipsoid without semi_z, with semi_z <= 0 or refinements > 7, a
+ *    semi_z on the 2D ellipse, a sphere poking out of the ellipsoid or
+ *    centred outside it, a cell without z: refused naming the key;
  *  - bad 3D input is refused as bad input (SP_ERR_INPUT) with a message
  *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
  *    the box, a z on a 2D mesh, and each feature not yet in 3D (shape
  *    term, local supports explicit or by auto with 5 cells or with
- *    divisions that can make more than 4, pictures, checkpoints, initial
- *    fields from files) with "not yet";
+ *    divisions that can make more than 4, pictures, initial fields from
+ *    files) with "not yet"; checkpoints load;
  *  - divisions load in 3D (phase 2) with layout.support full, or auto with
  *    division.max_cells <= 4;
  *  - `softpack run` of such a scene exits 2, names the key and writes
@@ -46,6 +49,18 @@ static void refused(const char *mesh, const char *extra, const char *key, const 
   sp_scene_destroy(&scene);
 }
 
+/** `softpack ARGS` exits 2, its message names @p key (and says @p also),
+ *  and test_scene_3d_out is not written. */
+static void run_refused(const char *args, const char *key, const char *also) {
+  char out[4096];
+  struct stat st;
+  const int status = run_softpack(args, out, sizeof out);
+  printf("softpack %s: exit %d: %s", args, status, out);
+  CHECK(status == 2, "exit status %d: %s", status, out);
+  CHECK(strstr(out, key) && (!also || strstr(out, also)), "output: %s", out);
+  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+}
+
 int main(void) {
   sp_scene *scene;
   CHECK_OK(load(NULL, "", &scene));
@@ -80,32 +95,52 @@ int main(void) {
           "  - {x: 0.1, y: 0.4, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.4, z: 0.0, radius: 0.05}\n",
           "layout.support", "not yet in 3D");
   refused(NULL, "output: {pictures: true}\n", "output.pictures", "not yet in 3D");
-  refused(NULL, "output: {pictures: false, checkpoint_every: 5}\n", "output.checkpoint_every",
-          "not yet in 3D");
-  refused(NULL, "output: {pictures: false, checkpoint_seconds: 60}\n",
-          "output.checkpoint_seconds", "not yet in 3D");
+  /* checkpoints are 3D too */
+  CHECK_OK(load(NULL, "output: {pictures: false, checkpoint_every: 5, checkpoint_seconds: 60}\n",
+                &scene));
+  CHECK(scene->output.checkpoint_every == 5, "checkpoint_every %d",
+        scene->output.checkpoint_every);
+  sp_scene_destroy(&scene);
   refused(NULL, "initial: {from: run.h5}\n", "initial.from", "not yet in 3D");
   refused(NULL, "initial: {label_image: cells.png}\n", "initial.label_image", "not yet in 3D");
+
+  /* the ellipsoid (mesh.type ellipsoid): semi_z required and > 0, only
+   * there; its refinements at most 7; spheres inside it */
+  const char *ellipsoid =
+      "mesh: {type: ellipsoid, refinements: 2, semi_x: 0.8, semi_y: 0.6, semi_z: 0.5}\n";
+  CHECK_OK(load(ellipsoid, "", &scene));
+  CHECK(sp_scene_dim(scene) == 3 && scene->mesh.type == SP_MESH_ELLIPSOID &&
+            scene->mesh.semi_z == 0.5,
+        "ellipsoid: dimension %d, semi_z %g", sp_scene_dim(scene), scene->mesh.semi_z);
+  sp_scene_destroy(&scene);
+  refused("mesh: {type: ellipsoid, refinements: 2, semi_x: 0.5, semi_y: 0.3}\n", "",
+          "mesh.semi_z", "required");
+  refused("mesh: {type: ellipsoid, semi_x: 0.5, semi_y: 0.3, semi_z: 0}\n", "", "mesh.semi_z",
+          "> 0");
+  refused("mesh: {type: ellipsoid, semi_x: 0.5, semi_y: 0.3, semi_z: -0.2}\n", "",
+          "mesh.semi_z", "> 0");
+  refused("mesh: {type: ellipsoid, refinements: 8, semi_x: 0.5, semi_y: 0.3, semi_z: 0.3}\n", "",
+          "mesh.refinements", "at most 7");
+  refused("mesh: {type: ellipse, semi_z: 0.3}\n", "", "mesh.semi_z", "only with");
+  refused(ellipsoid, "  - {x: 0.0, y: 0.0, z: 0.45, radius: 0.1}\n", "cells[1].radius",
+          "ellipsoid");
+  refused(ellipsoid, "  - {x: 0.0, y: 0.61, z: 0.0, radius: 0.01}\n", "cells[1].x", "outside");
+  refused(ellipsoid, "  - {x: 0.0, y: 0.0, radius: 0.1}\n", "cells[1].z", "required");
 
   /* the program: exit 2, the key named, nothing written */
   FILE *f = fopen("test_scene_3d.yaml", "w");
   CHECK(f != NULL, "cannot write the scene");
   fprintf(f, "%s%s%sshape: {delta1: 1e5}\n", good_mesh, good_output, good_cells);
   fclose(f);
-  char out[4096];
-  const int status =
-      run_softpack("run test_scene_3d.yaml --quiet --out test_scene_3d_out", out, sizeof out);
-  struct stat st;
-  printf("softpack run: exit %d: %s", status, out);
-  CHECK(status == 2, "exit status %d: %s", status, out);
-  CHECK(strstr(out, "shape.delta1") && strstr(out, "not yet in 3D"), "output: %s", out);
-  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+  run_refused("run test_scene_3d.yaml --quiet --out test_scene_3d_out", "shape.delta1",
+              "not yet in 3D");
   /* --set turns the pictures on: refused the same way */
-  const int status2 = run_softpack(
-      "run " SP_SOURCE_DIR "/tests/scenes/sphere_3d.yaml --quiet --out test_scene_3d_out "
-      "--set output.pictures=true",
-      out, sizeof out);
-  CHECK(status2 == 2 && strstr(out, "output.pictures"), "exit %d: %s", status2, out);
-  CHECK(stat("test_scene_3d_out", &st) != 0, "test_scene_3d_out was written");
+  run_refused("run " SP_SOURCE_DIR "/tests/scenes/sphere_3d.yaml --quiet --out test_scene_3d_out "
+              "--set output.pictures=true",
+              "output.pictures", NULL);
+  /* an ellipsoid's semi_z set below 0 */
+  run_refused("run " SP_SOURCE_DIR "/tests/scenes/two_spheres_ellipsoid.yaml --quiet --out "
+              "test_scene_3d_out --set mesh.semi_z=-1",
+              "mesh.semi_z", NULL);
   TEST_DONE();
 }
