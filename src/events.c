@@ -151,7 +151,7 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
   /* the parent's observables, with the cut's normal of its entry */
   sp_cell_obs parent_obs = run->cells.obs[parent];
   double long_axis[3], normal[3];
-  sp_lineage_obs_normal(&parent_obs, long_axis);
+  sp_lineage_obs_normal(&parent_obs, run->mesh->dim, long_axis);
   sp_lineage_normal(e, run->mesh->dim, long_axis, run->cells.cut_normal[parent], normal);
   if (e) sp_lineage_set_obs_normal(&parent_obs, normal);
   const int rc = split_state(run, parent, &parent_obs, e, new_layout, new_state);

@@ -135,13 +135,13 @@ void sp_lineage_normal(const sp_lineage_entry *e, int dim, const double long_axi
   orient(normal, dim);
 }
 
-void sp_lineage_obs_normal(const sp_cell_obs *obs, double normal[3]) {
-  normal[0] = -obs->v1[1];
-  normal[1] = obs->v1[0];
-  normal[2] = 0.0;
+void sp_lineage_obs_normal(const sp_cell_obs *obs, int dim, double normal[3]) {
+  double point[3];
+  sp_division_plane(obs, dim, point, normal);
 }
 
 void sp_lineage_set_obs_normal(sp_cell_obs *obs, const double normal[3]) {
+  for (int d = 0; d < 3; ++d) obs->v3[d] = normal[d]; /* (a 3D cut's normal) */
   /* n = (-v1_y, v1_x): v1 = (n_y, -n_x); v2 is n */
   obs->v1[0] = normal[1];
   obs->v1[1] = -normal[0] + 0.0; /* (+0, not -0, in divisions.csv) */

@@ -95,12 +95,12 @@ void sp_lineage_normal(const sp_lineage_entry *e, int dim, const double long_axi
 
 /**
  * @brief The cut's geometry as division.h reads it from a cell's
- *        observables: the cut normal of @p obs (sp_division_split's n = v1
- *        turned by +90 degrees: the long axis, v2 up to sign) into
- *        @p normal, and the converse, @p obs made to give @p normal.
- *        2D only: the observables have no 3D axes yet (issue 29).
+ *        observables: the cut normal of @p obs (sp_division_plane's: in 2D
+ *        v1 turned by +90 degrees, in 3D the long axis v3) into @p normal,
+ *        and the converse, @p obs made to give @p normal (v1, v2 in 2D,
+ *        v3 in 3D; a lineage table is refused on a 3D mesh for now).
  */
-void sp_lineage_obs_normal(const sp_cell_obs *obs, double normal[3]);
+void sp_lineage_obs_normal(const sp_cell_obs *obs, int dim, double normal[3]);
 void sp_lineage_set_obs_normal(sp_cell_obs *obs, const double normal[3]);
 
 /** @brief The daughters' names of a division of the cell named @p parent:

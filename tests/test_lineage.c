@@ -62,12 +62,12 @@ static void test_asymmetric_split(void) {
                                     .axis = fixed ? SP_AXIS_FIXED : SP_AXIS_LONG,
                                     .direction = {cos(1.2), sin(1.2), 0}};
         double long_axis[3], normal[3], zero[3] = {0, 0, 0};
-        sp_lineage_obs_normal(&before, long_axis);
+        sp_lineage_obs_normal(&before, 2, long_axis);
         sp_lineage_normal(&e, 2, long_axis, zero, normal);
         sp_cell_obs cut = before;
         sp_lineage_set_obs_normal(&cut, normal);
         double check[3];
-        sp_lineage_obs_normal(&cut, check);
+        sp_lineage_obs_normal(&cut, 2, check);
         CHECK(fabs(check[0] - normal[0]) + fabs(check[1] - normal[1]) < 1e-15,
               "the observables do not give the normal back");
         double offset;
