@@ -6,6 +6,13 @@
 #include "error.h"
 #include "q1.h"
 
+double sp_cells_line_angle(double dx, double dy) {
+  double angle = atan2(dy, dx);
+  if (angle <= -M_PI / 2) angle += M_PI;
+  if (angle > M_PI / 2) angle -= M_PI;
+  return angle;
+}
+
 void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
                         double *I2, double v1[2], double v2[2]) {
   const double mean = 0.5 * (Ixx + Iyy);
@@ -268,9 +275,7 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
     o->Ixy = -xy;
     sp_cells_principal(o->Ixx, o->Iyy, o->Ixy, &o->I1, &o->I2, o->v1, o->v2);
     o->v1[2] = o->v2[2] = 0.0;
-    o->angle = atan2(o->v1[1], o->v1[0]);
-    if (o->angle <= -M_PI / 2) o->angle += M_PI;
-    if (o->angle > M_PI / 2) o->angle -= M_PI;
+    o->angle = sp_cells_line_angle(o->v1[0], o->v1[1]);
     o->Izz = o->Ixz = o->Iyz = o->I3 = 0.0;
     o->v3[0] = o->v3[1] = o->v3[2] = 0.0;
   }

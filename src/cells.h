@@ -49,6 +49,11 @@ int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, d
  */
 int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *w);
 
+/** @brief The angle from the x axis of the line along (@p dx, @p dy), in
+ *         (-pi/2, pi/2] (a line has no direction: cells.csv's angle of v1,
+ *         divisions.csv's of the division line). */
+double sp_cells_line_angle(double dx, double dy);
+
 /** @brief Principal moments and unit eigenvectors of a symmetric 2x2
  *         tensor, larger first (v1 is the larger moment's). */
 void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,

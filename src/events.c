@@ -172,12 +172,8 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
   sp_lineage_daughter_names(e, parent_name, cells->name[parent], cells->name[child]);
   memcpy(cells->cut_normal[parent], normal, sizeof normal);
   memcpy(cells->cut_normal[child], normal, sizeof normal);
-  double px, py, dx, dy;
-  sp_division_axis(&parent_obs, &px, &py, &dx, &dy);
-  double angle = atan2(dy, dx);
-  if (angle <= -M_PI / 2) angle += M_PI;
-  if (angle > M_PI / 2) angle -= M_PI;
-  *record = (sp_division_record){.parent = parent, .child = child, .angle = angle,
+  /* (2D: the angle of v1, the division line, as the observables have it) */
+  *record = (sp_division_record){.parent = parent, .child = child, .angle = parent_obs.angle,
                                  .parent_mass = parent_obs.mass,
                                  .mass_a = cells->obs[parent].mass,
                                  .mass_b = cells->obs[child].mass,

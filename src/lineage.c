@@ -147,9 +147,7 @@ void sp_lineage_set_obs_normal(sp_cell_obs *obs, const double normal[3]) {
   obs->v1[1] = -normal[0] + 0.0; /* (+0, not -0, in divisions.csv) */
   obs->v2[0] = normal[0];
   obs->v2[1] = normal[1];
-  obs->angle = atan2(obs->v1[1], obs->v1[0]);
-  if (obs->angle <= -M_PI / 2) obs->angle += M_PI;
-  if (obs->angle > M_PI / 2) obs->angle -= M_PI;
+  obs->angle = sp_cells_line_angle(obs->v1[0], obs->v1[1]);
 }
 
 void sp_lineage_daughter_names(const sp_lineage_entry *e, const char *parent, sp_cell_name first,
