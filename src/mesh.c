@@ -111,6 +111,20 @@ static void mesh_finish(sp_mesh *mesh) {
  *  refinements in [0, @p max_refinements], @p dim finite positive semi-axes
  *  (a along x, b along y, c along z), buffer_layers in [0, 2^10] and, with
  *  layers, a finite positive buffer_width. */
+/** The arguments of the rectangle and the box (sp_mesh_rectangle,
+ *  sp_mesh_box): n[d] >= 1 elements and lo[d] < hi[d] along each of the
+ *  @p dim axes, every count before any extent, as each mesh checked them. */
+static int check_straight_arguments(int dim, const int *n, const double *lo, const double *hi) {
+  static const char name[3] = {'x', 'y', 'z'};
+  for (int d = 0; d < dim; ++d)
+    SP_CHECK(n[d] >= 1, SP_ERR_INPUT, "mesh: n%c must be >= 1, got %d", name[d], n[d]);
+  for (int d = 0; d < dim; ++d)
+    SP_CHECK(isfinite(lo[d]) && isfinite(hi[d]) && hi[d] > lo[d], SP_ERR_INPUT,
+             "mesh: need %c0 < %c1 (finite), got %c0 = %g, %c1 = %g", name[d], name[d],
+             name[d], lo[d], name[d], hi[d]);
+  return SP_OK;
+}
+
 static int check_curved_arguments(int refinements, int max_refinements, int dim,
                                   const double *semi, int buffer_layers,
                                   double buffer_width) {
@@ -147,12 +161,7 @@ int sp_mesh_rectangle(double x0, double y0, double x1, double y1, int nx,
                       int ny, sp_mesh **out) {
   SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_rectangle: out is NULL");
   *out = NULL;
-  SP_CHECK(nx >= 1, SP_ERR_INPUT, "mesh: nx must be >= 1, got %d", nx);
-  SP_CHECK(ny >= 1, SP_ERR_INPUT, "mesh: ny must be >= 1, got %d", ny);
-  SP_CHECK(isfinite(x0) && isfinite(x1) && x1 > x0, SP_ERR_INPUT,
-           "mesh: need x0 < x1 (finite), got x0 = %g, x1 = %g", x0, x1);
-  SP_CHECK(isfinite(y0) && isfinite(y1) && y1 > y0, SP_ERR_INPUT,
-           "mesh: need y0 < y1 (finite), got y0 = %g, y1 = %g", y0, y1);
+  SP_CALL(check_straight_arguments(2, (int[]){nx, ny}, (double[]){x0, y0}, (double[]){x1, y1}));
   /* (nx+1)(ny+1) must fit an int, and so must 4 nx ny. */
   SP_CHECK(sp_mesh_rectangle_nodes(nx, ny) < INT_MAX / 4, SP_ERR_INPUT,
            "mesh: nx x ny = %d x %d is too large", nx, ny);
@@ -197,15 +206,8 @@ int sp_mesh_box(double x0, double y0, double z0, double x1, double y1, double z1
                 int ny, int nz, sp_mesh **out) {
   SP_CHECK(out, SP_ERR_INPUT, "sp_mesh_box: out is NULL");
   *out = NULL;
-  SP_CHECK(nx >= 1, SP_ERR_INPUT, "mesh: nx must be >= 1, got %d", nx);
-  SP_CHECK(ny >= 1, SP_ERR_INPUT, "mesh: ny must be >= 1, got %d", ny);
-  SP_CHECK(nz >= 1, SP_ERR_INPUT, "mesh: nz must be >= 1, got %d", nz);
-  SP_CHECK(isfinite(x0) && isfinite(x1) && x1 > x0, SP_ERR_INPUT,
-           "mesh: need x0 < x1 (finite), got x0 = %g, x1 = %g", x0, x1);
-  SP_CHECK(isfinite(y0) && isfinite(y1) && y1 > y0, SP_ERR_INPUT,
-           "mesh: need y0 < y1 (finite), got y0 = %g, y1 = %g", y0, y1);
-  SP_CHECK(isfinite(z0) && isfinite(z1) && z1 > z0, SP_ERR_INPUT,
-           "mesh: need z0 < z1 (finite), got z0 = %g, z1 = %g", z0, z1);
+  SP_CALL(check_straight_arguments(3, (int[]){nx, ny, nz}, (double[]){x0, y0, z0},
+                                   (double[]){x1, y1, z1}));
   /* the nodes, and 8 nx ny nz element entries, must fit an int */
   SP_CHECK(sp_mesh_box_nodes(nx, ny, nz) < INT_MAX / 8, SP_ERR_INPUT,
            "mesh: nx x ny x nz = %d x %d x %d is too large", nx, ny, nz);
