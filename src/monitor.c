@@ -108,11 +108,21 @@ static int write_snapshot(sp_run *run) {
   if (run->rank != 0) return SP_OK;
   char path[4096];
   if (run->opt.output.pictures) {
-    snprintf(path, sizeof path, "%s/cells_%06d.png", sp_output_dir(mon->output), run->step);
-    SP_CALL(sp_render_cells(run->mesh, run->layout, run->state, run->t,
-                            run->opt.output.picture_width, path));
+    const char *dir = sp_output_dir(mon->output);
+    if (run->mesh->dim == 3) { /* the mid-plane sections and the cells' surfaces */
+      snprintf(path, sizeof path, "%s/sections_%06d.png", dir, run->step);
+      SP_CALL(sp_render_sections(run->mesh, run->layout, run->state, run->t,
+                                 run->opt.output.picture_width, path));
+      snprintf(path, sizeof path, "%s/surfaces_%06d.png", dir, run->step);
+      SP_CALL(sp_render_surfaces(run->mesh, run->layout, run->state, run->t,
+                                 run->opt.output.picture_width, path));
+    } else {
+      snprintf(path, sizeof path, "%s/cells_%06d.png", dir, run->step);
+      SP_CALL(sp_render_cells(run->mesh, run->layout, run->state, run->t,
+                              run->opt.output.picture_width, path));
+    }
     if (run->opt.output.contacts) {
-      snprintf(path, sizeof path, "%s/contacts_%06d.png", sp_output_dir(mon->output), run->step);
+      snprintf(path, sizeof path, "%s/contacts_%06d.png", dir, run->step);
       SP_CALL(sp_contacts_picture(&mon->contacts, run->mesh, run->cells.obs,
                                   run->opt.output.contact_threshold, run->t,
                                   run->opt.output.picture_width, path));
