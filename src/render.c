@@ -1207,6 +1207,34 @@ static int sp_cmp_face_key(const void *a, const void *b) {
   return 0;
 }
 
+/** Face @p f of element @p e, a quadrilateral of Omega's boundary turned
+ *  outwards (away from the element's centre), to @p front if it faces the
+ *  camera, else to @p back. */
+static int sp_omega_face_push(const sp_mesh *m, int e, int f, const sp_camera *cam,
+                              sp_faces2d *front, sp_faces2d *back) {
+  static const double shell[3] = {0.70, 0.74, 0.80};
+  const int *node = m->elem + 8 * (size_t)e;
+  double x[4][3], xf[3] = {0, 0, 0}, xc[3] = {0, 0, 0};
+  for (int a = 0; a < 8; ++a)
+    for (int d = 0; d < 3; ++d) xc[d] += 0.125 * m->xy[3 * (size_t)node[a] + d];
+  for (int a = 0; a < 4; ++a)
+    for (int d = 0; d < 3; ++d) {
+      x[a][d] = m->xy[3 * (size_t)node[sp_hex_faces[f][a]] + d];
+      xf[d] += 0.25 * x[a][d];
+    }
+  double d1[3], d2[3], n[3], out[3];
+  for (int d = 0; d < 3; ++d) {
+    d1[d] = x[2][d] - x[0][d];
+    d2[d] = x[3][d] - x[1][d];
+    out[d] = xf[d] - xc[d];
+  }
+  sp_cross3(d1, d2, n);
+  sp_normalise3(n);
+  if (sp_dot3(n, out) < 0)
+    for (int d = 0; d < 3; ++d) n[d] = -n[d];
+  return sp_faces2d_push(sp_dot3(n, cam->view) < 0 ? front : back, cam, 4, &x[0][0], n, shell);
+}
+
 /**
  * The boundary of Omega (the inner surface of the eggshell, or the box):
  * the faces of Omega elements that no other Omega element shares, as
@@ -1232,44 +1260,25 @@ static int sp_omega_faces(const sp_mesh *m, const sp_camera *cam, sp_faces2d *fr
     }
   }
   qsort(keys, nk, sizeof *keys, sp_cmp_face_key);
-  static const double shell[3] = {0.70, 0.74, 0.80};
   int rc = SP_OK;
   for (size_t i = 0; i < nk && rc == SP_OK;) {
     size_t j = i + 1;
     while (j < nk && sp_cmp_face_key(keys + j, keys + i) == 0) ++j;
-    if (j - i == 1) {
-      const int e = keys[i].elem, *node = m->elem + 8 * (size_t)e;
-      double x[4][3], xf[3] = {0, 0, 0}, xc[3] = {0, 0, 0};
-      for (int a = 0; a < 8; ++a)
-        for (int d = 0; d < 3; ++d) xc[d] += 0.125 * m->xy[3 * (size_t)node[a] + d];
-      for (int a = 0; a < 4; ++a)
-        for (int d = 0; d < 3; ++d) {
-          x[a][d] = m->xy[3 * (size_t)node[sp_hex_faces[keys[i].face][a]] + d];
-          xf[d] += 0.25 * x[a][d];
-        }
-      double d1[3], d2[3], n[3], out[3];
-      for (int d = 0; d < 3; ++d) {
-        d1[d] = x[2][d] - x[0][d];
-        d2[d] = x[3][d] - x[1][d];
-        out[d] = xf[d] - xc[d];
-      }
-      sp_cross3(d1, d2, n);
-      sp_normalise3(n);
-      if (sp_dot3(n, out) < 0)
-        for (int d = 0; d < 3; ++d) n[d] = -n[d];
-      rc = sp_faces2d_push(sp_dot3(n, cam->view) < 0 ? front : back, cam, 4, &x[0][0], n,
-                           shell);
-    }
+    if (j - i == 1) rc = sp_omega_face_push(m, keys[i].elem, keys[i].face, cam, front, back);
     i = j;
   }
   free(keys);
   return rc;
 }
 
-/** Fill the polygons of @p fs in their order; with @p alpha < 1 as one
+/** Fill the polygons of @p fs in their order, without antialiasing (the
+ *  polygons' own edges, antialiased, would let the background show
+ *  through as seams between neighbours); with @p alpha < 1 as one
  *  translucent layer (drawn opaque into a group, painted with alpha, so
  *  their shared edges do not show). */
 static void sp_faces2d_fill(cairo_t *cr, const sp_faces2d *fs, double alpha) {
+  const cairo_antialias_t antialias = cairo_get_antialias(cr);
+  cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
   if (alpha < 1) cairo_push_group(cr);
   for (size_t i = 0; i < fs->n; ++i) {
     const sp_face2d *f = fs->f + i;
@@ -1283,6 +1292,7 @@ static void sp_faces2d_fill(cairo_t *cr, const sp_faces2d *fs, double alpha) {
     cairo_pop_group_to_source(cr);
     cairo_paint_with_alpha(cr, alpha);
   }
+  cairo_set_antialias(cr, antialias);
 }
 
 /** The axes' directions in a corner, so the oblique view can be read. */
@@ -1307,13 +1317,9 @@ static void sp_axes_triad(cairo_t *cr, const sp_camera *cam) {
 static int sp_draw_surfaces(cairo_surface_t *surf, const sp_camera *cam, sp_faces2d fs[3],
                             double t) {
   cairo_t *cr = cairo_create(surf);
-  /* the triangles' own edges, antialiased, would let the background show
-   * through as seams between neighbours */
-  cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
   sp_faces2d_fill(cr, &fs[0], 0.3);  /* the far side of the eggshell */
   sp_faces2d_fill(cr, &fs[1], 1.0);  /* the cells, far to near */
   sp_faces2d_fill(cr, &fs[2], 0.12); /* the near side, over them */
-  cairo_set_antialias(cr, CAIRO_ANTIALIAS_DEFAULT);
   sp_axes_triad(cr, cam);
   sp_time_label(cr, cam->w / 50.0, 1.3 * cam->font, cam->font, t);
   const int rc = sp_cairo_check(cairo_status(cr), "drawing", "surfaces");
@@ -1468,9 +1474,7 @@ int sp_render_contact_graph(const sp_mesh *mesh, int n_cells, const double *cent
     if (dim == 3) {
       for (int i = 0; i < 2; ++i)
         if (shell[i].n) qsort(shell[i].f, shell[i].n, sizeof *shell[i].f, sp_cmp_far_first);
-      cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
       sp_faces2d_fill(cr, &shell[0], 0.3);
-      cairo_set_antialias(cr, CAIRO_ANTIALIAS_DEFAULT);
       sp_time_label(cr, w / 50.0, 1.3 * cam.font, cam.font, t);
     } else {
       rc = sp_outline_and_time(cr, mesh, &fr, lw, t, "contact graph");
@@ -1478,9 +1482,7 @@ int sp_render_contact_graph(const sp_mesh *mesh, int n_cells, const double *cent
     if (rc == SP_OK)
       rc = sp_draw_contact_graph(cr, &v, dim, n_cells, centre, n_edges, edge, length, lw);
     if (rc == SP_OK && dim == 3) {
-      cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
       sp_faces2d_fill(cr, &shell[1], 0.12);
-      cairo_set_antialias(cr, CAIRO_ANTIALIAS_DEFAULT);
       sp_axes_triad(cr, &cam);
       rc = sp_cairo_check(cairo_status(cr), "drawing", path);
     }

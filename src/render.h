@@ -74,7 +74,7 @@ int sp_render_sections_pixel(const sp_mesh *mesh, int width_px, int plane, const
  *        a fixed oblique orthographic camera, inside the boundary of Omega
  *        drawn translucent (the eggshell's inner surface, or the box), with
  *        the axes' directions in a corner and the time above; @p width_px
- *        wide, the height from the projected bounding box.
+ *        wide, the height from the mesh's projection.
  */
 int sp_render_surfaces(const sp_mesh *mesh, const sp_layout *layout, const double *state,
                        double t, int width_px, const char *path);
