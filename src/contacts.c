@@ -151,15 +151,17 @@ int sp_contacts_picture(const sp_contacts *c, const sp_mesh *mesh, const sp_cell
   const size_t pairs = (size_t)n * (size_t)(n > 0 ? n - 1 : 0) / 2;
   double *centre, *length;
   int *edge;
-  SP_ALLOC(centre, 2 * (size_t)n);
+  const int dim = mesh->dim;
+  SP_ALLOC(centre, (size_t)dim * n);
   int rc = SP_OK;
   length = malloc(sizeof(double) * (pairs ? pairs : 1));
   edge = malloc(sizeof(int) * 2 * (pairs ? pairs : 1));
   if (!length || !edge) rc = sp_error_set(SP_ERR_MEMORY, "out of memory for the contact graph");
   int n_edges = 0;
   for (int k = 0; k < n && rc == SP_OK; ++k) {
-    centre[2 * k] = obs[k].xc;
-    centre[2 * k + 1] = obs[k].yc;
+    centre[dim * k] = obs[k].xc;
+    centre[dim * k + 1] = obs[k].yc;
+    if (dim == 3) centre[dim * k + 2] = obs[k].zc;
     for (int l = k + 1; l < n; ++l)
       if (sp_contacts_touch(c, k, l, threshold)) {
         edge[2 * n_edges] = k;

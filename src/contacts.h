@@ -92,7 +92,8 @@ int sp_contacts_log_write(sp_contacts_log *log, int step, double t, const sp_con
 /** @brief Close contacts.csv (a NULL file is fine). */
 int sp_contacts_log_close(sp_contacts_log *log);
 
-/** @brief The contact graph picture (2D meshes): the cells as nodes at
+/** @brief The contact graph picture (in 3D seen as sp_render_surfaces sees the
+ *         cells): the cells as nodes at
  *         their centres (@p obs), an edge per pair in contact, its width
  *         proportional to the contact (render.h's sp_render_contact_graph). */
 int sp_contacts_picture(const sp_contacts *c, const sp_mesh *mesh, const sp_cell_obs *obs,

@@ -44,7 +44,8 @@ static void usage(FILE *to) {
           "       softpack --version the version and the git revision\n"
           "       softpack --help\n"
           "Outputs go to DIR (default out/<scene name>): energy.csv, cells.csv,\n"
-          "fields.pvd + fields_*.vtu (ParaView), cells_*.png, energy.png.\n"
+          "fields.pvd + fields_*.vtu (ParaView), cells_*.png (3D: sections_*.png,\n"
+          "surfaces_*.png), energy.png.\n"
           "Exit status: 0 ok, 2 bad input (nothing written), 1 failure, 75 stopped by\n"
           "SIGTERM/SIGINT/SIGUSR1 after writing a checkpoint (resume with --resume DIR).\n");
 }

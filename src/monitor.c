@@ -99,25 +99,38 @@ static int write_fields(sp_run *run) {
   return sp_output_fields(mon->output, run->mesh, run->layout, run->state, run->step, run->t);
 }
 
-/** The fields of the state, its picture (output.pictures)
+/** The pictures of the state (output.pictures; rank 0): in 2D
+ *  cells_<step>.png, in 3D sections_<step>.png and surfaces_<step>.png,
+ *  and with output.contacts contacts_<step>.png. */
+static int write_pictures(sp_run *run) {
+  sp_monitor *mon = &run->mon;
+  const char *dir = sp_output_dir(mon->output);
+  const int width = run->opt.output.picture_width;
+  char path[4096];
+  if (run->mesh->dim == 3) {
+    snprintf(path, sizeof path, "%s/sections_%06d.png", dir, run->step);
+    SP_CALL(sp_render_sections(run->mesh, run->layout, run->state, run->t, width, path));
+    snprintf(path, sizeof path, "%s/surfaces_%06d.png", dir, run->step);
+    SP_CALL(sp_render_surfaces(run->mesh, run->layout, run->state, run->t, width, path));
+  } else {
+    snprintf(path, sizeof path, "%s/cells_%06d.png", dir, run->step);
+    SP_CALL(sp_render_cells(run->mesh, run->layout, run->state, run->t, width, path));
+  }
+  if (!run->opt.output.contacts) return SP_OK;
+  snprintf(path, sizeof path, "%s/contacts_%06d.png", dir, run->step);
+  return sp_contacts_picture(&mon->contacts, run->mesh, run->cells.obs,
+                             run->opt.output.contact_threshold, run->t, width, path);
+}
+
+/** The fields of the state, its pictures (output.pictures)
  *  and energy.png. */
 static int write_snapshot(sp_run *run) {
   sp_monitor *mon = &run->mon;
   SP_CALL(sp_fault_check(SP_FAULT_OUTPUT, run->rank));
   SP_CALL(write_fields(run));
   if (run->rank != 0) return SP_OK;
+  if (run->opt.output.pictures) SP_CALL(write_pictures(run));
   char path[4096];
-  if (run->opt.output.pictures) {
-    snprintf(path, sizeof path, "%s/cells_%06d.png", sp_output_dir(mon->output), run->step);
-    SP_CALL(sp_render_cells(run->mesh, run->layout, run->state, run->t,
-                            run->opt.output.picture_width, path));
-    if (run->opt.output.contacts) {
-      snprintf(path, sizeof path, "%s/contacts_%06d.png", sp_output_dir(mon->output), run->step);
-      SP_CALL(sp_contacts_picture(&mon->contacts, run->mesh, run->cells.obs,
-                                  run->opt.output.contact_threshold, run->t,
-                                  run->opt.output.picture_width, path));
-    }
-  }
   snprintf(path, sizeof path, "%s/energy.png", sp_output_dir(mon->output));
   return sp_render_energy(mon->energy_t, mon->energy_total, mon->n_energy, mon->division_t,
                           mon->n_divisions, path);

@@ -113,6 +113,37 @@ static uint32_t sp_pixel(const double rgb[3]) {
   return 0xff000000u | c[0] << 16 | c[1] << 8 | c[2];
 }
 
+/** A white RGB24 surface of w x h pixels, or an error. */
+static int sp_white_surface(int w, int h, const char *path, cairo_surface_t **out) {
+  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, w, h);
+  const int rc = sp_cairo_check(cairo_surface_status(surf), "creating a surface", path);
+  if (rc != SP_OK) {
+    cairo_surface_destroy(surf);
+    return rc;
+  }
+  cairo_t *cr = cairo_create(surf);
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  cairo_destroy(cr);
+  *out = surf;
+  return SP_OK;
+}
+
+/** The layout is one of the mesh's nodes. */
+static int sp_layout_check(const sp_mesh *mesh, const sp_layout *layout) {
+  SP_CHECK(layout && layout->n_nodes == mesh->n_nodes, SP_ERR_INTERNAL,
+           "render: mesh has %d nodes but layout has %d", mesh->n_nodes,
+           layout ? layout->n_nodes : -1);
+  return SP_OK;
+}
+
+/** The outputs of the *_pixel functions (any pointer may be NULL). */
+static void sp_pixel_out(double u, double v, int h, double *px, double *py, int *height_px) {
+  if (px) *px = u;
+  if (py) *py = v;
+  if (height_px) *height_px = h;
+}
+
 /* ------------------------------------------------------------------------ */
 /* Cells picture                                                            */
 /* ------------------------------------------------------------------------ */
@@ -126,25 +157,42 @@ typedef struct {
   double font;    /**< font size of the time label */
 } sp_frame;
 
-static int sp_frame_make(const sp_mesh *m, int width_px, sp_frame *fr) {
+/**
+ * The bounding box lo[d] .. hi[d] (d < mesh->dim; the rest 0) of the
+ * mesh's nodes, not mesh->bounds: with a buffer the mesh reaches beyond
+ * Omega.
+ */
+static int sp_mesh_bbox(const sp_mesh *m, double lo[3], double hi[3]) {
   SP_CHECK(m && m->n_nodes > 0 && m->xy, SP_ERR_INTERNAL,
            "render: empty mesh");
+  const int dim = m->dim;
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = d < dim ? HUGE_VAL : 0.0;
+    hi[d] = d < dim ? -HUGE_VAL : 0.0;
+  }
+  for (int i = 0; i < m->n_nodes; ++i)
+    for (int d = 0; d < dim; ++d) {
+      lo[d] = fmin(lo[d], m->xy[(size_t)dim * i + d]);
+      hi[d] = fmax(hi[d], m->xy[(size_t)dim * i + d]);
+    }
+  for (int d = 0; d < dim; ++d)
+    SP_CHECK(isfinite(lo[d]) && isfinite(hi[d]) && hi[d] > lo[d], SP_ERR_INTERNAL,
+             "render: degenerate mesh bounding box: [%g, %g] along axis %d", lo[d], hi[d], d);
+  return SP_OK;
+}
+
+/** The picture width @p width_px is one the renderer draws. */
+static int sp_width_check(int width_px) {
   SP_CHECK(width_px >= 16 && width_px <= 16384, SP_ERR_INPUT,
            "render: picture width %d px is outside [16, 16384]", width_px);
-  /* The bounding box of the nodes, not mesh->bounds: with a buffer ring
-   * the mesh reaches beyond Omega. */
-  double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
-  for (int i = 0; i < m->n_nodes; ++i) {
-    double x = m->xy[2 * i], y = m->xy[2 * i + 1];
-    x0 = fmin(x0, x);
-    x1 = fmax(x1, x);
-    y0 = fmin(y0, y);
-    y1 = fmax(y1, y);
-  }
-  SP_CHECK(isfinite(x0) && isfinite(x1) && isfinite(y0) && isfinite(y1) &&
-               x1 > x0 && y1 > y0,
-           SP_ERR_INTERNAL, "render: degenerate mesh bounding box "
-           "[%g, %g] x [%g, %g]", x0, x1, y0, y1);
+  return SP_OK;
+}
+
+static int sp_frame_make(const sp_mesh *m, int width_px, sp_frame *fr) {
+  SP_CALL(sp_width_check(width_px));
+  double lo[3], hi[3];
+  SP_CALL(sp_mesh_bbox(m, lo, hi));
+  const double x0 = lo[0], y0 = lo[1], x1 = hi[0], y1 = hi[1];
   int margin = width_px / 50 > 4 ? width_px / 50 : 4;
   fr->font = fmax(10.0, width_px / 45.0);
   int band = (int)ceil(1.8 * fr->font); /* a white strip for the time */
@@ -170,13 +218,11 @@ static void sp_frame_map(const sp_frame *fr, double x, double y, double *px,
 
 int sp_render_cells_pixel(const sp_mesh *mesh, int width_px, double x,
                           double y, double *px, double *py, int *height_px) {
-  sp_frame fr;
+  sp_frame fr = {0};
   SP_CALL(sp_frame_make(mesh, width_px, &fr));
   double u, v;
   sp_frame_map(&fr, x, y, &u, &v);
-  if (px) *px = u;
-  if (py) *py = v;
-  if (height_px) *height_px = fr.h;
+  sp_pixel_out(u, v, fr.h, px, py, height_px);
   return SP_OK;
 }
 
@@ -291,6 +337,18 @@ static int sp_omega_outline(cairo_t *cr, const sp_mesh *m, const sp_frame *fr) {
   return SP_OK;
 }
 
+/** "t = ..." in black, its baseline starting at (x, y). */
+static void sp_time_label(cairo_t *cr, double x, double y, double font, double t) {
+  char label[64];
+  snprintf(label, sizeof label, "t = %.2e", t);
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
+                         CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, font);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_move_to(cr, x, y);
+  cairo_show_text(cr, label);
+}
+
 /** The outline of Omega (line width 1.5 @p lw) and the time in the white
  *  strip above the picture: what every picture on the cells' frame has. */
 static int sp_outline_and_time(cairo_t *cr, const sp_mesh *m, const sp_frame *fr, double lw,
@@ -299,22 +357,13 @@ static int sp_outline_and_time(cairo_t *cr, const sp_mesh *m, const sp_frame *fr
   cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
   cairo_set_line_width(cr, 1.5 * lw);
   cairo_stroke(cr);
-  char label[64];
-  snprintf(label, sizeof label, "t = %.2e", t);
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL,
-                         CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, fr->font);
-  cairo_set_source_rgb(cr, 0, 0, 0);
-  cairo_move_to(cr, fr->ox, 1.3 * fr->font);
-  cairo_show_text(cr, label);
+  sp_time_label(cr, fr->ox, 1.3 * fr->font, fr->font, t);
   return sp_cairo_check(cairo_status(cr), "drawing", what);
 }
 
-/** Everything drawn on an existing white RGB24 surface. */
-static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
-                         const sp_mesh *m, const sp_layout *l,
-                         const double *state, double t) {
-  /* phi at the nodes: the max over the cells supported there. */
+/** phi = max_k c_k at the nodes (NaN wins, so a broken state shows grey). */
+static int sp_phi_nodes(const sp_mesh *m, const sp_layout *l, const double *state,
+                        double **out) {
   double *phi;
   SP_ALLOC(phi, m->n_nodes);
   for (int i = 0; i < m->n_nodes; ++i) {
@@ -323,6 +372,17 @@ static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
       if (state[2 * p] > v || isnan(state[2 * p])) v = state[2 * p];
     phi[i] = v;
   }
+  *out = phi;
+  return SP_OK;
+}
+
+/** Everything drawn on an existing white RGB24 surface. */
+static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
+                         const sp_mesh *m, const sp_layout *l,
+                         const double *state, double t) {
+  /* phi at the nodes: the max over the cells supported there. */
+  double *phi;
+  SP_CALL(sp_phi_nodes(m, l, state, &phi));
 
   cairo_surface_flush(surf);
   uint32_t *data = (uint32_t *)cairo_image_surface_get_data(surf);
@@ -380,100 +440,18 @@ static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
 int sp_render_cells(const sp_mesh *mesh, const sp_layout *layout,
                     const double *state, double t, int width_px,
                     const char *path) {
-  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
-           "render: pictures are not yet on a 3D mesh (issue 29)");
-  SP_CHECK(layout && layout->n_nodes == mesh->n_nodes, SP_ERR_INTERNAL,
-           "render: mesh has %d nodes but layout has %d", mesh->n_nodes,
-           layout ? layout->n_nodes : -1);
-  sp_frame fr;
+  SP_CHECK(mesh->dim == 2, SP_ERR_INTERNAL,
+           "render: the cells picture is 2D (a 3D state has sp_render_sections and "
+           "sp_render_surfaces)");
+  SP_CALL(sp_layout_check(mesh, layout));
+  sp_frame fr = {0};
   SP_CALL(sp_frame_make(mesh, width_px, &fr));
-  cairo_surface_t *surf =
-      cairo_image_surface_create(CAIRO_FORMAT_RGB24, fr.w, fr.h);
-  int rc = sp_cairo_check(cairo_surface_status(surf), "creating a surface",
-                          path);
-  if (rc == SP_OK) {
-    /* White first: whatever the mesh does not cover stays white. */
-    cairo_t *cr = cairo_create(surf);
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    cairo_paint(cr);
-    cairo_destroy(cr);
-    rc = sp_draw_cells(surf, &fr, mesh, layout, state, t);
-  }
+  /* White first: whatever the mesh does not cover stays white. */
+  cairo_surface_t *surf = NULL;
+  int rc = sp_white_surface(fr.w, fr.h, path, &surf);
+  if (rc == SP_OK) rc = sp_draw_cells(surf, &fr, mesh, layout, state, t);
   if (rc == SP_OK) rc = sp_png_write(surf, path);
-  cairo_surface_destroy(surf);
-  return rc;
-}
-
-/* ------------------------------------------------------------------------ */
-/* Contact graph                                                            */
-/* ------------------------------------------------------------------------ */
-
-/** The graph on a white surface: the outline and the time, then the
- *  edges, then the numbered discs on top. */
-static int sp_draw_contact_graph(cairo_t *cr, const sp_frame *fr, const sp_mesh *m,
-                                 int n_cells, const double *centre, int n_edges,
-                                 const int *edge, const double *length, double t) {
-  const double lw = fmax(1.0, fr->w / 700.0);
-  SP_CALL(sp_outline_and_time(cr, m, fr, lw, t, "contact graph"));
-  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
-  cairo_set_source_rgba(cr, 0.15, 0.3, 0.7, 0.8);
-  for (int j = 0; j < n_edges; ++j) {
-    double ax, ay, bx, by;
-    sp_frame_map(fr, centre[2 * edge[2 * j]], centre[2 * edge[2 * j] + 1], &ax, &ay);
-    sp_frame_map(fr, centre[2 * edge[2 * j + 1]], centre[2 * edge[2 * j + 1] + 1], &bx, &by);
-    /* a quarter of the contact's length at the picture's scale */
-    cairo_set_line_width(cr, fmax(1.0, 0.25 * length[j] * fr->s));
-    cairo_move_to(cr, ax, ay);
-    cairo_line_to(cr, bx, by);
-    cairo_stroke(cr);
-  }
-  const double radius = 0.8 * fr->font;
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
-  cairo_set_font_size(cr, 0.9 * fr->font);
-  for (int k = 0; k < n_cells; ++k) {
-    double x, y;
-    sp_frame_map(fr, centre[2 * k], centre[2 * k + 1], &x, &y);
-    cairo_new_sub_path(cr);
-    cairo_arc(cr, x, y, radius, 0, 2 * sp_pi);
-    cairo_set_source_rgb(cr, 0.85, 0.15, 0.1);
-    cairo_fill_preserve(cr);
-    cairo_set_source_rgb(cr, 0, 0, 0);
-    cairo_set_line_width(cr, lw);
-    cairo_stroke(cr);
-    char label[16];
-    snprintf(label, sizeof label, "%d", k + 1); /* cells numbered from 1, as in cells.csv */
-    cairo_text_extents_t ext;
-    cairo_text_extents(cr, label, &ext);
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    cairo_move_to(cr, x - ext.width / 2 - ext.x_bearing, y - ext.height / 2 - ext.y_bearing);
-    cairo_show_text(cr, label);
-  }
-  return sp_cairo_check(cairo_status(cr), "drawing", "contact graph");
-}
-
-int sp_render_contact_graph(const sp_mesh *mesh, int n_cells, const double *centre,
-                            int n_edges, const int *edge, const double *length, double t,
-                            int width_px, const char *path) {
-  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
-           "render: pictures are not yet on a 3D mesh (issue 29)");
-  for (int j = 0; j < n_edges; ++j)
-    SP_CHECK(edge[2 * j] >= 0 && edge[2 * j] < n_cells && edge[2 * j + 1] >= 0 &&
-                 edge[2 * j + 1] < n_cells,
-             SP_ERR_INTERNAL, "render: contact %d joins cells %d and %d of %d", j, edge[2 * j],
-             edge[2 * j + 1], n_cells);
-  sp_frame fr;
-  SP_CALL(sp_frame_make(mesh, width_px, &fr));
-  cairo_surface_t *surf = cairo_image_surface_create(CAIRO_FORMAT_RGB24, fr.w, fr.h);
-  int rc = sp_cairo_check(cairo_surface_status(surf), "creating a surface", path);
-  if (rc == SP_OK) {
-    cairo_t *cr = cairo_create(surf);
-    cairo_set_source_rgb(cr, 1, 1, 1);
-    cairo_paint(cr);
-    rc = sp_draw_contact_graph(cr, &fr, mesh, n_cells, centre, n_edges, edge, length, t);
-    cairo_destroy(cr);
-  }
-  if (rc == SP_OK) rc = sp_png_write(surf, path);
-  cairo_surface_destroy(surf);
+  if (surf) cairo_surface_destroy(surf);
   return rc;
 }
 
@@ -663,5 +641,855 @@ int sp_render_energy(const double *t, const double *energy, int n,
   cairo_destroy(cr);
   if (rc == SP_OK) rc = sp_png_write(surf, path);
   cairo_surface_destroy(surf);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------ */
+/* 3D: the level surfaces of Q1 fields on hexahedra                         */
+/* ------------------------------------------------------------------------ */
+
+/** The faces of a hexahedron, each as its local nodes in cyclic order
+ *  (q1.h's numbering: 0..3 the bottom face, 4..7 the top one). */
+static const int sp_hex_faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                       {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+
+/** A growing list of triangles, 9 coordinates each. */
+typedef struct {
+  double *xyz;
+  size_t n, cap;
+} sp_tris;
+
+static int sp_tris_push(sp_tris *t, const double *p0, const double *p1, const double *p2) {
+  if (t->n == t->cap) {
+    size_t cap = t->cap ? 2 * t->cap : 1024;
+    double *xyz = realloc(t->xyz, 9 * sizeof(double) * cap);
+    SP_CHECK(xyz, SP_ERR_MEMORY, "render: out of memory for %zu triangles", cap);
+    t->xyz = xyz;
+    t->cap = cap;
+  }
+  double *q = t->xyz + 9 * t->n++;
+  for (int d = 0; d < 3; ++d) q[d] = p0[d], q[3 + d] = p1[d], q[6 + d] = p2[d];
+  return SP_OK;
+}
+
+/** Add triangle (p0, p1, p2), turned so that its normal (p1 - p0) x
+ *  (p2 - p0) has a positive component along @p out. */
+static int sp_tris_push_facing(sp_tris *t, const double *p0, const double *p1,
+                               const double *p2, const double out[3]) {
+  double a[3], b[3];
+  for (int d = 0; d < 3; ++d) a[d] = p1[d] - p0[d], b[d] = p2[d] - p0[d];
+  const double n[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                       a[0] * b[1] - a[1] * b[0]};
+  const double dot = n[0] * out[0] + n[1] * out[1] + n[2] * out[2];
+  return dot >= 0 ? sp_tris_push(t, p0, p1, p2) : sp_tris_push(t, p0, p2, p1);
+}
+
+/**
+ * The point where v = level on the edge from @p pi (v = vi >= level) to
+ * @p po (vo < level). Always computed from the inside end, so the two
+ * tetrahedra sharing an edge make bit-identical points.
+ */
+static void sp_edge_point(const double *pi, double vi, const double *po, double vo,
+                          double level, double x[3]) {
+  const double s = (level - vi) / (vo - vi);
+  for (int d = 0; d < 3; ++d) x[d] = pi[d] + s * (po[d] - pi[d]);
+}
+
+/**
+ * The piece of {v = level} in one tetrahedron (marching tetrahedra on the
+ * linear interpolant): a triangle when one or three vertices are inside
+ * (v >= level), a quadrilateral as two triangles when two are; turned to
+ * face from the inside vertices to the outside ones.
+ */
+static int sp_march_tet(const double *p[4], const double v[4], double level, sp_tris *t) {
+  int in[4], out[4], n_in = 0, n_out = 0;
+  for (int a = 0; a < 4; ++a) {
+    if (v[a] >= level) in[n_in++] = a;
+    else out[n_out++] = a;
+  }
+  if (n_in == 0 || n_out == 0) return SP_OK;
+  double dir[3] = {0, 0, 0}; /* from the inside vertices' centroid to the outside ones' */
+  for (int d = 0; d < 3; ++d) {
+    for (int j = 0; j < n_out; ++j) dir[d] += p[out[j]][d] / n_out;
+    for (int j = 0; j < n_in; ++j) dir[d] -= p[in[j]][d] / n_in;
+  }
+  double q[4][3];
+#define SP_EDGE(k, i, o) sp_edge_point(p[i], v[i], p[o], v[o], level, q[k])
+  if (n_in == 1) {
+    for (int j = 0; j < 3; ++j) SP_EDGE(j, in[0], out[j]);
+    return sp_tris_push_facing(t, q[0], q[1], q[2], dir);
+  }
+  if (n_in == 3) {
+    for (int j = 0; j < 3; ++j) SP_EDGE(j, in[j], out[0]);
+    return sp_tris_push_facing(t, q[0], q[1], q[2], dir);
+  }
+  /* in a, b and out c, d: the crossed edges ac, ad, bd, bc in cyclic order */
+  SP_EDGE(0, in[0], out[0]);
+  SP_EDGE(1, in[0], out[1]);
+  SP_EDGE(2, in[1], out[1]);
+  SP_EDGE(3, in[1], out[0]);
+#undef SP_EDGE
+  SP_CALL(sp_tris_push_facing(t, q[0], q[1], q[2], dir));
+  return sp_tris_push_facing(t, q[0], q[2], q[3], dir);
+}
+
+/**
+ * The piece of {v = level} in hexahedron @p e: the hexahedron is cut into
+ * 24 tetrahedra, each made of one edge of a face, the face's centre and the
+ * hexahedron's centre (the trilinear field's values there: the means of the
+ * face's 4 and the element's 8 nodal values). Every face is cut the same
+ * way from both sides whatever the two elements' orientations (the cubed
+ * ball's patches meet at differently oriented hexahedra), so the surface
+ * closes; the face centre is summed over its nodes in the order of their
+ * global numbers, so both sides compute it to the same bits.
+ */
+static int sp_march_hex(const sp_mesh *m, int e, const double *v, double level, sp_tris *t) {
+  const int *node = m->elem + 8 * (size_t)e;
+  double val[8];
+  int n_in = 0;
+  for (int a = 0; a < 8; ++a) {
+    val[a] = v[node[a]];
+    n_in += val[a] >= level;
+  }
+  if (n_in == 0 || n_in == 8) return SP_OK;
+  double x[8][3], xc[3] = {0, 0, 0}, vc = 0;
+  for (int a = 0; a < 8; ++a) {
+    for (int d = 0; d < 3; ++d) {
+      x[a][d] = m->xy[3 * (size_t)node[a] + d];
+      xc[d] += 0.125 * x[a][d];
+    }
+    vc += 0.125 * val[a];
+  }
+  for (int f = 0; f < 6; ++f) {
+    int order[4];
+    for (int j = 0; j < 4; ++j) { /* the face's nodes by global number */
+      int a = sp_hex_faces[f][j], i = j;
+      for (; i > 0 && node[order[i - 1]] > node[a]; --i) order[i] = order[i - 1];
+      order[i] = a;
+    }
+    double xf[3] = {0, 0, 0}, vf = 0;
+    for (int j = 0; j < 4; ++j) {
+      for (int d = 0; d < 3; ++d) xf[d] += 0.25 * x[order[j]][d];
+      vf += 0.25 * val[order[j]];
+    }
+    for (int j = 0; j < 4; ++j) {
+      const int a = sp_hex_faces[f][j], b = sp_hex_faces[f][(j + 1) % 4];
+      const double *p[4] = {x[a], x[b], xf, xc};
+      const double vt[4] = {val[a], val[b], vf, vc};
+      SP_CALL(sp_march_tet(p, vt, level, t));
+    }
+  }
+  return SP_OK;
+}
+
+static int sp_level_surface(const sp_mesh *mesh, const double *v, double level, sp_tris *t) {
+  for (int e = 0; e < mesh->n_elems; ++e) SP_CALL(sp_march_hex(mesh, e, v, level, t));
+  return SP_OK;
+}
+
+int sp_render_level_surface(const sp_mesh *mesh, const double *v, double level, double **tri,
+                            size_t *n_tri) {
+  SP_CHECK(mesh && mesh->dim == 3 && v && tri && n_tri, SP_ERR_INTERNAL,
+           "render: a level surface needs a 3D mesh and its nodal values");
+  sp_tris t = {NULL, 0, 0};
+  const int rc = sp_level_surface(mesh, v, level, &t);
+  if (rc != SP_OK) {
+    free(t.xyz);
+    return rc;
+  }
+  *tri = t.xyz;
+  *n_tri = t.n;
+  return SP_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* 3D: the three mid-plane sections                                         */
+/* ------------------------------------------------------------------------ */
+
+/** Panel a of the sections picture is the plane x_a = the box's middle,
+ *  seen with axis [a][0] to the right and axis [a][1] up. */
+static const int sp_section_axes[3][2] = {{1, 2}, {0, 2}, {0, 1}};
+static const char *const sp_axis_names[3] = {"x", "y", "z"};
+
+/** World-to-pixel map of the sections picture: one scale for the three
+ *  panels, side by side, each with room on its left for its vertical
+ *  axis's labels. */
+typedef struct {
+  double lo[3], hi[3], mid[3]; /**< the nodes' bounding box, its middle */
+  double s;                    /**< pixels per unit length */
+  double left[3];              /**< pixel x of each panel's left edge */
+  double top;                  /**< pixel y of the panels' top edge */
+  int w, h;
+  double font;
+} sp_sections_frame;
+
+static int sp_sections_frame_make(const sp_mesh *m, int width_px, sp_sections_frame *fr) {
+  SP_CHECK(m && m->dim == 3, SP_ERR_INTERNAL, "render: sections need a 3D mesh");
+  SP_CALL(sp_width_check(width_px));
+  SP_CALL(sp_mesh_bbox(m, fr->lo, fr->hi));
+  for (int d = 0; d < 3; ++d) fr->mid[d] = 0.5 * (fr->lo[d] + fr->hi[d]);
+  const double margin = width_px / 50 > 4 ? width_px / 50 : 4;
+  fr->font = fmax(10.0, width_px / 60.0);
+  const double room = 3.5 * fr->font; /* left of each panel: its vertical axis */
+  double across = 0, tall = 0;        /* the panels' total width, largest height */
+  for (int a = 0; a < 3; ++a) {
+    const int hx = sp_section_axes[a][0], vx = sp_section_axes[a][1];
+    across += fr->hi[hx] - fr->lo[hx];
+    tall = fmax(tall, fr->hi[vx] - fr->lo[vx]);
+  }
+  fr->s = (width_px - 2 * margin - 3 * room) / across;
+  SP_CHECK(fr->s > 0, SP_ERR_INPUT, "render: a %d px wide picture leaves no room for sections",
+           width_px);
+  double x = margin;
+  for (int a = 0; a < 3; ++a) {
+    const int hx = sp_section_axes[a][0];
+    fr->left[a] = x + room;
+    x = fr->left[a] + (fr->hi[hx] - fr->lo[hx]) * fr->s;
+  }
+  fr->top = margin + 3.6 * fr->font; /* the time, then the panels' titles */
+  const double h = ceil(fr->top + tall * fr->s + 2.4 * fr->font + margin);
+  SP_CHECK(h <= 32768, SP_ERR_INPUT, "render: %d px wide sections would be %.0f px high",
+           width_px, h);
+  fr->w = width_px;
+  fr->h = (int)h;
+  return SP_OK;
+}
+
+/** Pixel of the point @p x (3 coordinates) in panel @p a. */
+static void sp_sections_map(const sp_sections_frame *fr, int a, const double *x, double *px,
+                            double *py) {
+  const int hx = sp_section_axes[a][0], vx = sp_section_axes[a][1];
+  *px = fr->left[a] + (x[hx] - fr->lo[hx]) * fr->s;
+  *py = fr->top + (fr->hi[vx] - x[vx]) * fr->s;
+}
+
+int sp_render_sections_pixel(const sp_mesh *mesh, int width_px, int plane, const double *x,
+                             double *px, double *py, int *height_px) {
+  SP_CHECK(plane >= 0 && plane < 3, SP_ERR_INTERNAL, "render: section plane %d", plane);
+  sp_sections_frame fr = {0};
+  SP_CALL(sp_sections_frame_make(mesh, width_px, &fr));
+  double u, v;
+  sp_sections_map(&fr, plane, x, &u, &v);
+  sp_pixel_out(u, v, fr.h, px, py, height_px);
+  return SP_OK;
+}
+
+/**
+ * The reference point xi of the physical point @p X in the hexahedron with
+ * nodes @p xe (Newton on the trilinear map from the centre). Returns 1 if X
+ * lies in the element (xi in [-1, 1]^3 to 1e-9), else 0.
+ */
+static int sp_hex_locate(const double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], const double *X,
+                         double xi[SP_Q1_MAX_DIM]) {
+  xi[0] = xi[1] = xi[2] = 0;
+  for (int it = 0; it < 20; ++it) {
+    double N[SP_Q1_MAX_NODES], dN[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+    sp_q1_shape(3, xi, N, dN);
+    double r[3], J[3][3] = {{0}};
+    for (int d = 0; d < 3; ++d) {
+      r[d] = -X[d];
+      for (int a = 0; a < 8; ++a) {
+        r[d] += N[a] * xe[a][d];
+        for (int k = 0; k < 3; ++k) J[d][k] += xe[a][d] * dN[a][k];
+      }
+    }
+    const double det = J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
+                       J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+                       J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+    if (!(fabs(det) > 0)) return 0;
+    double step = 0;
+    for (int k = 0; k < 3; ++k) { /* Cramer: column k of J replaced by -r */
+      double M[3][3];
+      for (int d = 0; d < 3; ++d)
+        for (int c = 0; c < 3; ++c) M[d][c] = c == k ? -r[d] : J[d][c];
+      const double dk = (M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
+                         M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+                         M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0])) / det;
+      xi[k] += dk;
+      step = fmax(step, fabs(dk));
+    }
+    if (fabs(xi[0]) > 4 || fabs(xi[1]) > 4 || fabs(xi[2]) > 4) return 0; /* far outside */
+    if (step < 1e-12) break;
+  }
+  return fabs(xi[0]) <= 1 + 1e-9 && fabs(xi[1]) <= 1 + 1e-9 && fabs(xi[2]) <= 1 + 1e-9;
+}
+
+/**
+ * Colour the pixels of panel @p a that lie in the plane's section of each
+ * element with jet(phi), phi interpolated trilinearly at the pixel centre
+ * (the element walked, its slice rasterised over its bounding box's
+ * pixels); buffer elements washed out as in 2D.
+ */
+static void sp_section_fill(uint32_t *data, int stride, const sp_sections_frame *fr, int a,
+                            const sp_mesh *m, const double *phi) {
+  const int hx = sp_section_axes[a][0], vx = sp_section_axes[a][1];
+  const double x0 = fr->left[a], x1 = x0 + (fr->hi[hx] - fr->lo[hx]) * fr->s;
+  const double y0 = fr->top, y1 = y0 + (fr->hi[vx] - fr->lo[vx]) * fr->s;
+  for (int e = 0; e < m->n_elems; ++e) {
+    double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+    sp_mesh_elem_xy(m, e, xe);
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int n = 0; n < 8; ++n)
+      for (int d = 0; d < 3; ++d) lo[d] = fmin(lo[d], xe[n][d]), hi[d] = fmax(hi[d], xe[n][d]);
+    if (fr->mid[a] < lo[a] || fr->mid[a] > hi[a]) continue;
+    double plo, phi_, qlo, qhi; /* the element's pixel box */
+    sp_sections_map(fr, a, lo, &plo, &qhi);
+    sp_sections_map(fr, a, hi, &phi_, &qlo);
+    const int i0 = (int)fmax(ceil(fmax(plo, x0) - 0.5), 0);
+    const int i1 = (int)fmin(floor(fmin(phi_, x1) - 0.5), fr->w - 1);
+    const int j0 = (int)fmax(ceil(fmax(qlo, y0) - 0.5), 0);
+    const int j1 = (int)fmin(floor(fmin(qhi, y1) - 0.5), fr->h - 1);
+    const int lighten = m->region && m->region[e] != SP_REGION_OMEGA;
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        double X[3], xi[SP_Q1_MAX_DIM];
+        X[a] = fr->mid[a];
+        X[hx] = fr->lo[hx] + (i + 0.5 - fr->left[a]) / fr->s;
+        X[vx] = fr->hi[vx] - (j + 0.5 - fr->top) / fr->s;
+        if (!sp_hex_locate(xe, X, xi)) continue;
+        double N[SP_Q1_MAX_NODES], dN[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], v = 0;
+        sp_q1_shape(3, xi, N, dN);
+        for (int n = 0; n < 8; ++n) v += N[n] * phi[m->elem[8 * (size_t)e + n]];
+        double rgb[3];
+        sp_jet(v, rgb);
+        if (lighten)
+          for (int c = 0; c < 3; ++c) rgb[c] = 0.55 * rgb[c] + 0.45;
+        data[(size_t)j * stride + i] = sp_pixel(rgb);
+      }
+  }
+}
+
+/** Text with its left (@p align 0), centre (0.5) or right (1) at x, its
+ *  baseline at y. */
+static void sp_text(cairo_t *cr, double x, double y, double align, const char *text) {
+  cairo_text_extents_t ext;
+  cairo_text_extents(cr, text, &ext);
+  cairo_move_to(cr, x - align * ext.width - ext.x_bearing, y);
+  cairo_show_text(cr, text);
+}
+
+/** The time, and each panel's frame, title (its plane) and axes (names and
+ *  end values). */
+static int sp_sections_labels(cairo_surface_t *surf, const sp_sections_frame *fr, double t) {
+  cairo_t *cr = cairo_create(surf);
+  char label[64];
+  sp_time_label(cr, fr->left[0] - 3.5 * fr->font, 1.4 * fr->font, 1.2 * fr->font, t);
+  cairo_set_line_width(cr, 1);
+  for (int a = 0; a < 3; ++a) {
+    const int hx = sp_section_axes[a][0], vx = sp_section_axes[a][1];
+    const double x0 = fr->left[a], x1 = x0 + (fr->hi[hx] - fr->lo[hx]) * fr->s;
+    const double y0 = fr->top, y1 = y0 + (fr->hi[vx] - fr->lo[vx]) * fr->s;
+    cairo_set_source_rgb(cr, 0.6, 0.6, 0.6);
+    cairo_rectangle(cr, floor(x0) - 0.5, floor(y0) - 0.5, ceil(x1) - floor(x0) + 1,
+                    ceil(y1) - floor(y0) + 1);
+    cairo_stroke(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_font_size(cr, 1.1 * fr->font);
+    snprintf(label, sizeof label, "%s = %.3g", sp_axis_names[a], fr->mid[a]);
+    sp_text(cr, 0.5 * (x0 + x1), y0 - 0.6 * fr->font, 0.5, label);
+    cairo_set_font_size(cr, fr->font);
+    /* horizontal axis: its ends' values, its name in the middle */
+    snprintf(label, sizeof label, "%.3g", fr->lo[hx]);
+    sp_text(cr, x0, y1 + 1.3 * fr->font, 0, label);
+    snprintf(label, sizeof label, "%.3g", fr->hi[hx]);
+    sp_text(cr, x1, y1 + 1.3 * fr->font, 1, label);
+    sp_text(cr, 0.5 * (x0 + x1), y1 + 1.6 * fr->font, 0.5, sp_axis_names[hx]);
+    /* vertical axis: the same on the panel's left */
+    snprintf(label, sizeof label, "%.3g", fr->lo[vx]);
+    sp_text(cr, x0 - 0.4 * fr->font, y1, 1, label);
+    snprintf(label, sizeof label, "%.3g", fr->hi[vx]);
+    sp_text(cr, x0 - 0.4 * fr->font, y0 + fr->font, 1, label);
+    sp_text(cr, x0 - 0.6 * fr->font, 0.5 * (y0 + y1) + 0.4 * fr->font, 1, sp_axis_names[vx]);
+  }
+  const int rc = sp_cairo_check(cairo_status(cr), "drawing", "sections");
+  cairo_destroy(cr);
+  return rc;
+}
+
+int sp_render_sections(const sp_mesh *mesh, const sp_layout *layout, const double *state,
+                       double t, int width_px, const char *path) {
+  SP_CALL(sp_layout_check(mesh, layout));
+  sp_sections_frame fr = {0};
+  SP_CALL(sp_sections_frame_make(mesh, width_px, &fr));
+  double *phi;
+  SP_CALL(sp_phi_nodes(mesh, layout, state, &phi));
+  cairo_surface_t *surf = NULL;
+  int rc = sp_white_surface(fr.w, fr.h, path, &surf);
+  if (rc == SP_OK) {
+    cairo_surface_flush(surf);
+    uint32_t *data = (uint32_t *)cairo_image_surface_get_data(surf);
+    const int stride = cairo_image_surface_get_stride(surf) / 4;
+    for (int a = 0; a < 3; ++a) sp_section_fill(data, stride, &fr, a, mesh, phi);
+    cairo_surface_mark_dirty(surf);
+    rc = sp_sections_labels(surf, &fr, t);
+  }
+  free(phi);
+  if (rc == SP_OK) rc = sp_png_write(surf, path);
+  cairo_surface_destroy(surf);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------ */
+/* 3D: the cells' surfaces seen by a fixed oblique camera                   */
+/* ------------------------------------------------------------------------ */
+
+/** The camera: orthographic, looking along @p view from the front right,
+ *  above (azimuth 35 degrees from -y towards +x, elevation 25 degrees);
+ *  a point X goes to pixel (ox + s (X - centre).right, oy - s (X - centre).up)
+ *  at depth (X - centre).view. */
+typedef struct {
+  double right[3], up[3], view[3], light[3];
+  double centre[3];
+  double s, ox, oy;
+  int w, h;
+  double font;
+} sp_camera;
+
+static double sp_dot3(const double *a, const double *b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void sp_cross3(const double *a, const double *b, double *c) {
+  c[0] = a[1] * b[2] - a[2] * b[1];
+  c[1] = a[2] * b[0] - a[0] * b[2];
+  c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static void sp_normalise3(double *a) {
+  const double n = sqrt(sp_dot3(a, a));
+  if (n > 0)
+    for (int d = 0; d < 3; ++d) a[d] /= n;
+}
+
+static void sp_camera_map(const sp_camera *cam, const double *x, double *px, double *py,
+                          double *depth) {
+  const double r[3] = {x[0] - cam->centre[0], x[1] - cam->centre[1], x[2] - cam->centre[2]};
+  *px = cam->ox + cam->s * sp_dot3(r, cam->right);
+  *py = cam->oy - cam->s * sp_dot3(r, cam->up);
+  if (depth) *depth = sp_dot3(r, cam->view);
+}
+
+static int sp_camera_make(const sp_mesh *m, int width_px, sp_camera *cam) {
+  SP_CHECK(m && m->dim == 3, SP_ERR_INTERNAL, "render: a 3D view needs a 3D mesh");
+  SP_CALL(sp_width_check(width_px));
+  double lo[3], hi[3];
+  SP_CALL(sp_mesh_bbox(m, lo, hi));
+  const double az = 35 * sp_pi / 180, el = 25 * sp_pi / 180;
+  const double eye[3] = {sin(az) * cos(el), -cos(az) * cos(el), sin(el)}; /* towards the eye */
+  const double z[3] = {0, 0, 1};
+  for (int d = 0; d < 3; ++d) {
+    cam->view[d] = -eye[d];
+    cam->centre[d] = 0.5 * (lo[d] + hi[d]);
+  }
+  sp_cross3(cam->view, z, cam->right);
+  sp_normalise3(cam->right);
+  sp_cross3(cam->right, cam->view, cam->up);
+  for (int d = 0; d < 3; ++d) /* one light, above and left of the eye */
+    cam->light[d] = eye[d] + 0.6 * cam->up[d] - 0.4 * cam->right[d];
+  sp_normalise3(cam->light);
+  cam->s = 1;
+  cam->ox = cam->oy = 0;
+  double u0 = HUGE_VAL, u1 = -HUGE_VAL, v0 = HUGE_VAL, v1 = -HUGE_VAL;
+  for (int i = 0; i < m->n_nodes; ++i) { /* the mesh's outline at scale 1 */
+    double u, v;
+    sp_camera_map(cam, m->xy + 3 * (size_t)i, &u, &v, NULL);
+    u0 = fmin(u0, u), u1 = fmax(u1, u), v0 = fmin(v0, v), v1 = fmax(v1, v);
+  }
+  const double margin = width_px / 50 > 4 ? width_px / 50 : 4;
+  cam->font = fmax(10.0, width_px / 45.0);
+  const double band = ceil(1.8 * cam->font);
+  cam->s = (width_px - 2 * margin) / (u1 - u0);
+  cam->ox = margin - u0 * cam->s;
+  cam->oy = band + margin - v0 * cam->s; /* v grows downwards here */
+  const double h = ceil(band + 2 * margin + (v1 - v0) * cam->s);
+  SP_CHECK(h <= 32768, SP_ERR_INPUT, "render: a %d px wide 3D view would be %.0f px high",
+           width_px, h);
+  cam->w = width_px;
+  cam->h = (int)h;
+  return SP_OK;
+}
+
+/** A flat polygon to draw: its corners in pixels, its depth (the centroid's;
+ *  larger is farther) and its colour. */
+typedef struct {
+  float p[4][2];
+  float depth;
+  float rgb[3];
+  int n; /**< 3 or 4 corners */
+} sp_face2d;
+
+typedef struct {
+  sp_face2d *f;
+  size_t n, cap;
+} sp_faces2d;
+
+/** Project the polygon @p x (n corners) and shade @p rgb by Lambert's law
+ *  for its unit normal @p normal: ambient 0.3 plus 0.7 n.light. */
+static int sp_faces2d_push(sp_faces2d *fs, const sp_camera *cam, int n, const double *x,
+                           const double normal[3], const double rgb[3]) {
+  if (fs->n == fs->cap) {
+    size_t cap = fs->cap ? 2 * fs->cap : 4096;
+    sp_face2d *f = realloc(fs->f, sizeof *f * cap);
+    SP_CHECK(f, SP_ERR_MEMORY, "render: out of memory for %zu faces", cap);
+    fs->f = f;
+    fs->cap = cap;
+  }
+  sp_face2d *f = fs->f + fs->n++;
+  double depth = 0;
+  for (int a = 0; a < n; ++a) {
+    double px, py, dz;
+    sp_camera_map(cam, x + 3 * a, &px, &py, &dz);
+    f->p[a][0] = (float)px;
+    f->p[a][1] = (float)py;
+    depth += dz / n;
+  }
+  f->n = n;
+  f->depth = (float)depth;
+  const double lambert = 0.3 + 0.7 * fmax(0.0, sp_dot3(normal, cam->light));
+  for (int c = 0; c < 3; ++c) f->rgb[c] = (float)(lambert * rgb[c]);
+  return SP_OK;
+}
+
+static int sp_cmp_far_first(const void *a, const void *b) {
+  const float x = ((const sp_face2d *)a)->depth, y = ((const sp_face2d *)b)->depth;
+  return (x < y) - (x > y);
+}
+
+/** Cell colours of the 3D view, cycled: distinct hues, none of them the
+ *  background's white or the eggshell's grey. */
+static const double sp_cell_palette[10][3] = {
+    {0.86, 0.25, 0.20}, {0.22, 0.49, 0.85}, {0.30, 0.70, 0.30}, {0.95, 0.65, 0.15},
+    {0.58, 0.38, 0.78}, {0.15, 0.70, 0.72}, {0.90, 0.45, 0.70}, {0.62, 0.62, 0.20},
+    {0.60, 0.36, 0.22}, {0.45, 0.45, 0.55}};
+
+/** The front-facing triangles of each cell's c = 1/2 surface, coloured
+ *  per cell and shaded. */
+static int sp_cell_faces(const sp_mesh *m, const sp_layout *l, const double *state,
+                         const sp_camera *cam, sp_faces2d *fs) {
+  const sp_cell_pairs *cp;
+  SP_CALL(sp_layout_cells(l, &cp));
+  double *c;
+  SP_ALLOC(c, m->n_nodes);
+  sp_tris t = {NULL, 0, 0};
+  int rc = SP_OK;
+  for (int k = 0; k < l->n_cells && rc == SP_OK; ++k) {
+    memset(c, 0, sizeof *c * (size_t)m->n_nodes); /* 0 off the cell's support */
+    for (int64_t j = cp->cell_start[k]; j < cp->cell_start[k + 1]; ++j)
+      c[cp->cell_node[j]] = state[2 * (size_t)cp->cell_pair[j]];
+    t.n = 0;
+    rc = sp_level_surface(m, c, 0.5, &t);
+    for (size_t i = 0; i < t.n && rc == SP_OK; ++i) {
+      const double *x = t.xyz + 9 * i;
+      double a[3], b[3], n[3];
+      for (int d = 0; d < 3; ++d) a[d] = x[3 + d] - x[d], b[d] = x[6 + d] - x[d];
+      sp_cross3(a, b, n);
+      sp_normalise3(n);
+      if (sp_dot3(n, cam->view) >= 0) continue; /* faces away: hidden by the front */
+      rc = sp_faces2d_push(fs, cam, 3, x, n, sp_cell_palette[k % 10]);
+    }
+  }
+  free(t.xyz);
+  free(c);
+  return rc;
+}
+
+/** A hexahedron face by its sorted global nodes, for finding the faces only
+ *  one Omega element has. */
+typedef struct {
+  int key[4];
+  int elem, face;
+} sp_face_key;
+
+static int sp_cmp_face_key(const void *a, const void *b) {
+  const int *x = ((const sp_face_key *)a)->key, *y = ((const sp_face_key *)b)->key;
+  for (int i = 0; i < 4; ++i)
+    if (x[i] != y[i]) return (x[i] > y[i]) - (x[i] < y[i]);
+  return 0;
+}
+
+/** Face @p f of element @p e, a quadrilateral of Omega's boundary turned
+ *  outwards (away from the element's centre), to @p front if it faces the
+ *  camera, else to @p back. */
+static int sp_omega_face_push(const sp_mesh *m, int e, int f, const sp_camera *cam,
+                              sp_faces2d *front, sp_faces2d *back) {
+  static const double shell[3] = {0.70, 0.74, 0.80};
+  const int *node = m->elem + 8 * (size_t)e;
+  double x[4][3], xf[3] = {0, 0, 0}, xc[3] = {0, 0, 0};
+  for (int a = 0; a < 8; ++a)
+    for (int d = 0; d < 3; ++d) xc[d] += 0.125 * m->xy[3 * (size_t)node[a] + d];
+  for (int a = 0; a < 4; ++a)
+    for (int d = 0; d < 3; ++d) {
+      x[a][d] = m->xy[3 * (size_t)node[sp_hex_faces[f][a]] + d];
+      xf[d] += 0.25 * x[a][d];
+    }
+  double d1[3], d2[3], n[3], out[3];
+  for (int d = 0; d < 3; ++d) {
+    d1[d] = x[2][d] - x[0][d];
+    d2[d] = x[3][d] - x[1][d];
+    out[d] = xf[d] - xc[d];
+  }
+  sp_cross3(d1, d2, n);
+  sp_normalise3(n);
+  if (sp_dot3(n, out) < 0)
+    for (int d = 0; d < 3; ++d) n[d] = -n[d];
+  return sp_faces2d_push(sp_dot3(n, cam->view) < 0 ? front : back, cam, 4, &x[0][0], n, shell);
+}
+
+/**
+ * The boundary of Omega (the inner surface of the eggshell, or the box):
+ * the faces of Omega elements that no other Omega element shares, as
+ * quadrilaterals facing outwards; those facing the camera go to @p front,
+ * the others to @p back.
+ */
+static int sp_omega_faces(const sp_mesh *m, const sp_camera *cam, sp_faces2d *front,
+                          sp_faces2d *back) {
+  sp_face_key *keys;
+  SP_ALLOC(keys, 6 * (size_t)m->n_elems);
+  size_t nk = 0;
+  for (int e = 0; e < m->n_elems; ++e) {
+    if (m->region && m->region[e] != SP_REGION_OMEGA) continue;
+    for (int f = 0; f < 6; ++f) {
+      sp_face_key *k = keys + nk++;
+      for (int j = 0; j < 4; ++j) {
+        int v = m->elem[8 * (size_t)e + sp_hex_faces[f][j]], i = j;
+        for (; i > 0 && k->key[i - 1] > v; --i) k->key[i] = k->key[i - 1];
+        k->key[i] = v;
+      }
+      k->elem = e;
+      k->face = f;
+    }
+  }
+  qsort(keys, nk, sizeof *keys, sp_cmp_face_key);
+  int rc = SP_OK;
+  for (size_t i = 0; i < nk && rc == SP_OK;) {
+    size_t j = i + 1;
+    while (j < nk && sp_cmp_face_key(keys + j, keys + i) == 0) ++j;
+    if (j - i == 1) rc = sp_omega_face_push(m, keys[i].elem, keys[i].face, cam, front, back);
+    i = j;
+  }
+  free(keys);
+  return rc;
+}
+
+/** Fill the polygons of @p fs in their order, without antialiasing (the
+ *  polygons' own edges, antialiased, would let the background show
+ *  through as seams between neighbours); with @p alpha < 1 as one
+ *  translucent layer (drawn opaque into a group, painted with alpha, so
+ *  their shared edges do not show). */
+static void sp_faces2d_fill(cairo_t *cr, const sp_faces2d *fs, double alpha) {
+  const cairo_antialias_t antialias = cairo_get_antialias(cr);
+  cairo_set_antialias(cr, CAIRO_ANTIALIAS_NONE);
+  if (alpha < 1) cairo_push_group(cr);
+  for (size_t i = 0; i < fs->n; ++i) {
+    const sp_face2d *f = fs->f + i;
+    cairo_move_to(cr, f->p[0][0], f->p[0][1]);
+    for (int a = 1; a < f->n; ++a) cairo_line_to(cr, f->p[a][0], f->p[a][1]);
+    cairo_close_path(cr);
+    cairo_set_source_rgb(cr, f->rgb[0], f->rgb[1], f->rgb[2]);
+    cairo_fill(cr);
+  }
+  if (alpha < 1) {
+    cairo_pop_group_to_source(cr);
+    cairo_paint_with_alpha(cr, alpha);
+  }
+  cairo_set_antialias(cr, antialias);
+}
+
+/** The axes' directions in a corner, so the oblique view can be read. */
+static void sp_axes_triad(cairo_t *cr, const sp_camera *cam) {
+  const double len = 2.2 * cam->font;
+  const double ox = cam->w - 2.2 * len, oy = cam->h - 1.6 * len;
+  cairo_set_line_width(cr, fmax(1.0, cam->w / 500.0));
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, 0.9 * cam->font);
+  for (int d = 0; d < 3; ++d) {
+    const double e[3] = {d == 0, d == 1, d == 2};
+    const double ex = sp_dot3(e, cam->right), ey = -sp_dot3(e, cam->up);
+    cairo_set_source_rgb(cr, 0.2, 0.2, 0.2);
+    cairo_move_to(cr, ox, oy);
+    cairo_line_to(cr, ox + len * ex, oy + len * ey);
+    cairo_stroke(cr);
+    sp_text(cr, ox + 1.3 * len * ex, oy + 1.3 * len * ey + 0.35 * cam->font, 0.5,
+            sp_axis_names[d]);
+  }
+}
+
+static int sp_draw_surfaces(cairo_surface_t *surf, const sp_camera *cam, sp_faces2d fs[3],
+                            double t) {
+  cairo_t *cr = cairo_create(surf);
+  sp_faces2d_fill(cr, &fs[0], 0.3);  /* the far side of the eggshell */
+  sp_faces2d_fill(cr, &fs[1], 1.0);  /* the cells, far to near */
+  sp_faces2d_fill(cr, &fs[2], 0.12); /* the near side, over them */
+  sp_axes_triad(cr, cam);
+  sp_time_label(cr, cam->w / 50.0, 1.3 * cam->font, cam->font, t);
+  const int rc = sp_cairo_check(cairo_status(cr), "drawing", "surfaces");
+  cairo_destroy(cr);
+  return rc;
+}
+
+int sp_render_surfaces_pixel(const sp_mesh *mesh, int width_px, const double *x, double *px,
+                             double *py, int *height_px) {
+  sp_camera cam = {0};
+  SP_CALL(sp_camera_make(mesh, width_px, &cam));
+  double u, v;
+  sp_camera_map(&cam, x, &u, &v, NULL);
+  sp_pixel_out(u, v, cam.h, px, py, height_px);
+  return SP_OK;
+}
+
+int sp_render_surfaces(const sp_mesh *mesh, const sp_layout *layout, const double *state,
+                       double t, int width_px, const char *path) {
+  SP_CALL(sp_layout_check(mesh, layout));
+  sp_camera cam = {0};
+  SP_CALL(sp_camera_make(mesh, width_px, &cam));
+  sp_faces2d fs[3] = {{NULL, 0, 0}, {NULL, 0, 0}, {NULL, 0, 0}}; /* back shell, cells, front */
+  int rc = sp_omega_faces(mesh, &cam, &fs[2], &fs[0]);
+  if (rc == SP_OK) rc = sp_cell_faces(mesh, layout, state, &cam, &fs[1]);
+  cairo_surface_t *surf = NULL;
+  if (rc == SP_OK) {
+    for (int i = 0; i < 3; ++i)
+      if (fs[i].n) qsort(fs[i].f, fs[i].n, sizeof *fs[i].f, sp_cmp_far_first);
+    rc = sp_white_surface(cam.w, cam.h, path, &surf);
+  }
+  if (rc == SP_OK) rc = sp_draw_surfaces(surf, &cam, fs, t);
+  if (rc == SP_OK) rc = sp_png_write(surf, path);
+  if (surf) cairo_surface_destroy(surf);
+  for (int i = 0; i < 3; ++i) free(fs[i].f);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Contact graph                                                            */
+/* ------------------------------------------------------------------------ */
+
+/** The frame of a picture of either dimension: the cells picture's (2D) or
+ *  the 3D view's camera. */
+typedef struct {
+  const sp_frame *fr;   /**< 2D, else NULL */
+  const sp_camera *cam; /**< 3D, else NULL */
+  double s, font;       /**< pixels per unit length, font size */
+} sp_view;
+
+/** Pixel of the point @p x (the mesh's dim coordinates) and its depth (0 in
+ *  2D). */
+static void sp_view_map(const sp_view *v, const double *x, double *px, double *py,
+                        double *depth) {
+  if (v->fr) {
+    sp_frame_map(v->fr, x[0], x[1], px, py);
+    *depth = 0;
+  } else {
+    sp_camera_map(v->cam, x, px, py, depth);
+  }
+}
+
+/** A cell of the contact graph, for drawing the discs far to near. */
+typedef struct {
+  double px, py, depth;
+  int k;
+} sp_graph_node;
+
+static int sp_cmp_node_far_first(const void *a, const void *b) {
+  const sp_graph_node *x = a, *y = b;
+  if (x->depth != y->depth) return (x->depth < y->depth) - (x->depth > y->depth);
+  return (x->k > y->k) - (x->k < y->k);
+}
+
+/** The graph on a white surface: the edges, then the numbered discs on top
+ *  (in 3D far to near). */
+static int sp_draw_contact_graph(cairo_t *cr, const sp_view *v, int dim, int n_cells,
+                                 const double *centre, int n_edges, const int *edge,
+                                 const double *length, double lw) {
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  cairo_set_source_rgba(cr, 0.15, 0.3, 0.7, 0.8);
+  for (int j = 0; j < n_edges; ++j) {
+    double ax, ay, bx, by, depth;
+    sp_view_map(v, centre + dim * edge[2 * j], &ax, &ay, &depth);
+    sp_view_map(v, centre + dim * edge[2 * j + 1], &bx, &by, &depth);
+    /* a quarter of the contact's length (in 3D of the side of a square of
+     * its area) at the picture's scale */
+    const double size = dim == 3 ? sqrt(length[j]) : length[j];
+    cairo_set_line_width(cr, fmax(1.0, 0.25 * size * v->s));
+    cairo_move_to(cr, ax, ay);
+    cairo_line_to(cr, bx, by);
+    cairo_stroke(cr);
+  }
+  sp_graph_node *node;
+  SP_ALLOC(node, n_cells);
+  for (int k = 0; k < n_cells; ++k) {
+    node[k].k = k;
+    sp_view_map(v, centre + dim * k, &node[k].px, &node[k].py, &node[k].depth);
+  }
+  if (dim == 3) qsort(node, n_cells, sizeof *node, sp_cmp_node_far_first);
+  const double radius = 0.8 * v->font;
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  cairo_set_font_size(cr, 0.9 * v->font);
+  for (int i = 0; i < n_cells; ++i) {
+    const double x = node[i].px, y = node[i].py;
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, x, y, radius, 0, 2 * sp_pi);
+    cairo_set_source_rgb(cr, 0.85, 0.15, 0.1);
+    cairo_fill_preserve(cr);
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, lw);
+    cairo_stroke(cr);
+    char label[16];
+    snprintf(label, sizeof label, "%d", node[i].k + 1); /* numbered from 1, as in cells.csv */
+    cairo_text_extents_t ext;
+    cairo_text_extents(cr, label, &ext);
+    cairo_set_source_rgb(cr, 1, 1, 1);
+    cairo_move_to(cr, x - ext.width / 2 - ext.x_bearing, y - ext.height / 2 - ext.y_bearing);
+    cairo_show_text(cr, label);
+  }
+  free(node);
+  return sp_cairo_check(cairo_status(cr), "drawing", "contact graph");
+}
+
+int sp_render_contact_graph(const sp_mesh *mesh, int n_cells, const double *centre,
+                            int n_edges, const int *edge, const double *length, double t,
+                            int width_px, const char *path) {
+  for (int j = 0; j < n_edges; ++j)
+    SP_CHECK(edge[2 * j] >= 0 && edge[2 * j] < n_cells && edge[2 * j + 1] >= 0 &&
+                 edge[2 * j + 1] < n_cells,
+             SP_ERR_INTERNAL, "render: contact %d joins cells %d and %d of %d", j, edge[2 * j],
+             edge[2 * j + 1], n_cells);
+  const int dim = mesh->dim;
+  sp_frame fr = {0};
+  sp_camera cam = {0};
+  sp_view v = {NULL, NULL, 0, 0};
+  sp_faces2d shell[2] = {{NULL, 0, 0}, {NULL, 0, 0}}; /* 3D: Omega's far and near sides */
+  if (dim == 3) {
+    SP_CALL(sp_camera_make(mesh, width_px, &cam));
+    v = (sp_view){NULL, &cam, cam.s, cam.font};
+  } else {
+    SP_CALL(sp_frame_make(mesh, width_px, &fr));
+    v = (sp_view){&fr, NULL, fr.s, fr.font};
+  }
+  const int w = dim == 3 ? cam.w : fr.w, h = dim == 3 ? cam.h : fr.h;
+  const double lw = fmax(1.0, w / 700.0);
+  cairo_surface_t *surf = NULL;
+  int rc = dim == 3 ? sp_omega_faces(mesh, &cam, &shell[1], &shell[0]) : SP_OK;
+  if (rc == SP_OK) rc = sp_white_surface(w, h, path, &surf);
+  if (rc == SP_OK) {
+    cairo_t *cr = cairo_create(surf);
+    if (dim == 3) {
+      for (int i = 0; i < 2; ++i)
+        if (shell[i].n) qsort(shell[i].f, shell[i].n, sizeof *shell[i].f, sp_cmp_far_first);
+      sp_faces2d_fill(cr, &shell[0], 0.3);
+      sp_time_label(cr, w / 50.0, 1.3 * cam.font, cam.font, t);
+    } else {
+      rc = sp_outline_and_time(cr, mesh, &fr, lw, t, "contact graph");
+    }
+    if (rc == SP_OK)
+      rc = sp_draw_contact_graph(cr, &v, dim, n_cells, centre, n_edges, edge, length, lw);
+    if (rc == SP_OK && dim == 3) {
+      sp_faces2d_fill(cr, &shell[1], 0.12);
+      sp_axes_triad(cr, &cam);
+      rc = sp_cairo_check(cairo_status(cr), "drawing", path);
+    }
+    cairo_destroy(cr);
+  }
+  if (rc == SP_OK) rc = sp_png_write(surf, path);
+  if (surf) cairo_surface_destroy(surf);
+  for (int i = 0; i < 2; ++i) free(shell[i].f);
   return rc;
 }

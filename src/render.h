@@ -10,6 +10,8 @@
 #include "layout.h"
 #include "mesh.h"
 
+#include <stddef.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -31,15 +33,70 @@ int sp_render_cells_pixel(const sp_mesh *mesh, int width_px, double x,
 
 /**
  * @brief The contact graph on the cells picture's frame (the same size and
- *        world-to-pixel map as sp_render_cells, the outline of Omega): cell
- *        k a numbered disc at (@p centre[2k], @p centre[2k+1]), edge j a line
- *        between cells @p edge[2j] and @p edge[2j+1] (from 0) whose width is
- *        a quarter of @p length[j] (a contact length, in the mesh's units)
- *        at the picture's scale, at least one pixel; the time in a corner.
+ *        world-to-pixel map as sp_render_cells, the outline of Omega; in 3D
+ *        the frame, camera and translucent Omega of sp_render_surfaces): cell
+ *        k a numbered disc at its centre (@p centre[dim k + d], d < the
+ *        mesh's dim; in 3D drawn far to near), edge j a line between cells
+ *        @p edge[2j] and @p edge[2j+1] (from 0) whose width is a quarter of
+ *        @p length[j] (a contact length, in the mesh's units; in 3D a contact
+ *        area, and a quarter of its square root) at the picture's scale, at
+ *        least one pixel; the time in a corner.
  */
 int sp_render_contact_graph(const sp_mesh *mesh, int n_cells, const double *centre,
                             int n_edges, const int *edge, const double *length, double t,
                             int width_px, const char *path);
+
+/**
+ * @brief The three mid-plane sections of a 3D state (x, y and z = the
+ *        middle of the mesh's bounding box), side by side in one picture
+ *        @p width_px wide: phi = max_k c_k interpolated trilinearly in the
+ *        hexahedron under each pixel, in the 2D picture's colours (buffer
+ *        elements washed out, white outside the mesh), each panel with its
+ *        plane and axes labelled, the time above.
+ */
+int sp_render_sections(const sp_mesh *mesh, const sp_layout *layout, const double *state,
+                       double t, int width_px, const char *path);
+
+/**
+ * @brief Where sp_render_sections puts the point @p x (3 coordinates) in the
+ *        panel of plane @p plane (0: x = middle, showing y right and z up;
+ *        1: y = middle, x right, z up; 2: z = middle, x right, y up): pixel
+ *        coordinates as sp_render_cells_pixel's, and the picture's height
+ *        (any output pointer may be NULL).
+ */
+int sp_render_sections_pixel(const sp_mesh *mesh, int width_px, int plane, const double *x,
+                             double *px, double *py, int *height_px);
+
+/**
+ * @brief A 3D view of the cells: each cell's c = 1/2 surface (marching
+ *        tetrahedra, sp_render_level_surface) in a colour of its own, shaded
+ *        by one light (Lambert), drawn far to near (painter's algorithm) by
+ *        a fixed oblique orthographic camera, inside the boundary of Omega
+ *        drawn translucent (the eggshell's inner surface, or the box), with
+ *        the axes' directions in a corner and the time above; @p width_px
+ *        wide, the height from the mesh's projection.
+ */
+int sp_render_surfaces(const sp_mesh *mesh, const sp_layout *layout, const double *state,
+                       double t, int width_px, const char *path);
+
+/** @brief Where sp_render_surfaces puts the point @p x (3 coordinates), as
+ *         sp_render_cells_pixel, and the picture's height. */
+int sp_render_surfaces_pixel(const sp_mesh *mesh, int width_px, const double *x, double *px,
+                             double *py, int *height_px);
+
+/**
+ * @brief The level surface {v = @p level} of the Q1 field @p v (one value
+ *        per node) on a 3D mesh: each hexahedron cut into 24 tetrahedra
+ *        (an edge of a face, the face's centre, the element's centre),
+ *        marching tetrahedra on each. Closed where it does not reach the
+ *        mesh's boundary (neighbouring elements cut their shared face alike
+ *        and make bit-identical points on it); every triangle turned so
+ *        that (p1 - p0) x (p2 - p0) points towards v < level.
+ * @param[out] tri malloc'd 9 coordinates per triangle (the caller frees it)
+ * @param[out] n_tri the number of triangles
+ */
+int sp_render_level_surface(const sp_mesh *mesh, const double *v, double level, double **tri,
+                            size_t *n_tri);
 
 /** @brief Energy against time, with vertical marks at @p marks (e.g.
  *         division times; may be NULL). */

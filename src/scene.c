@@ -274,7 +274,7 @@ static const sp_key sp_keys[] = {
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
              "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
              "or an ellipsoid of hexahedra (3D; not yet with divisions, the shape "
-             "term, local supports, initial files or pictures: issue 29)"),
+             "term, local supports or initial files: issue 29)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
               "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
@@ -454,7 +454,8 @@ static const sp_key sp_keys[] = {
             AT_MOST(INT_MAX), "steps",
             "write fields and pictures every this many steps"),
     KEY_BOOL(SP_SEC_OUTPUT, "pictures", output.pictures, 1, "-",
-             "write PNG pictures"),
+             "write PNG pictures (2D: cells_<step>.png; 3D: sections_<step>.png "
+             "and surfaces_<step>.png, docs/3d.md)"),
     KEY_INT(SP_SEC_OUTPUT, "picture_width", output.picture_width, 800,
             AT_LEAST(64), AT_MOST(8192), "px", "picture width"),
     KEY_BOOL(SP_SEC_OUTPUT, "contacts", output.contacts, 1, "-",
@@ -1552,8 +1553,8 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
 #define SP_NOT_YET_3D "not yet in 3D (mesh.type box, ellipsoid; issue 29)"
 
 /** What a scene on a 3D mesh cannot ask for yet, each refused naming its
- *  key, rather than run wrong: the shape term, local supports, pictures
- *  and initial fields from files. */
+ *  key, rather than run wrong: the shape term, local supports and
+ *  initial fields from files. */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
   SP_CHECK(scene->n_lineage == 0, SP_ERR_INPUT,
@@ -1581,8 +1582,6 @@ static int check_3d(const sp_scene *scene, const char *file) {
            ": expected full for a scene with divisions (auto is local when divisions can make "
            "more than 4 cells; division.max_cells = %d, 0: from the volume)",
            file, max_cells);
-  SP_CHECK(!scene->output.pictures, SP_ERR_INPUT,
-           "%s: output.pictures: pictures are " SP_NOT_YET_3D ": expected false", file);
   SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
            "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
            ": expected none, got '%s'", file, scene->initial.from);

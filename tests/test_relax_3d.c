@@ -13,7 +13,8 @@
  *    ellipsoid) and the centre its (x, y, z) (within 1e-3);
  *  - what a 3D run writes: energy.csv, cells.csv with the z centre
  *    (step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,long_z,core_mass,
- *    volume), energy.png, no cell pictures (not yet in 3D), and the VTU
+ *    volume), energy.png, no 2D cells_<step>.png (3D pictures are
+ *    test_render_3d's; these scenes turn them off), and the VTU
  *    fields of hexahedra (check_vtu: counts, VTK type 12, the mesh's points
  *    with z and connectivity, VTK's node order), on the box and on the
  *    ellipsoid. */

@@ -8,8 +8,8 @@
  *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
  *    the box, a z on a 2D mesh, and each feature not yet in 3D (shape
  *    term, local supports explicit or by auto with 5 cells or with
- *    divisions that can make more than 4, pictures, initial fields from
- *    files) with "not yet"; checkpoints load;
+ *    divisions that can make more than 4, initial fields from files)
+ *    with "not yet"; pictures and checkpoints load;
  *  - divisions load in 3D (phase 2) with layout.support full, or auto with
  *    division.max_cells <= 4;
  *  - `softpack run` of such a scene exits 2, names the key and writes
@@ -94,7 +94,10 @@ int main(void) {
           "  - {x: 0.1, y: 0.1, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.1, z: 0.0, radius: 0.05}\n"
           "  - {x: 0.1, y: 0.4, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.4, z: 0.0, radius: 0.05}\n",
           "layout.support", "not yet in 3D");
-  refused(NULL, "output: {pictures: true}\n", "output.pictures", "not yet in 3D");
+  /* pictures are 3D too (render.c: sections and surfaces) */
+  CHECK_OK(load(NULL, "output: {pictures: true}\n", &scene));
+  CHECK(scene->output.pictures == 1, "pictures %d", scene->output.pictures);
+  sp_scene_destroy(&scene);
   /* checkpoints are 3D too */
   CHECK_OK(load(NULL, "output: {pictures: false, checkpoint_every: 5, checkpoint_seconds: 60}\n",
                 &scene));
@@ -134,10 +137,10 @@ int main(void) {
   fclose(f);
   run_refused("run test_scene_3d.yaml --quiet --out test_scene_3d_out", "shape.delta1",
               "not yet in 3D");
-  /* --set turns the pictures on: refused the same way */
+  /* --set a picture width below its range: refused the same way */
   run_refused("run " SP_SOURCE_DIR "/tests/scenes/sphere_3d.yaml --quiet --out test_scene_3d_out "
-              "--set output.pictures=true",
-              "output.pictures", NULL);
+              "--set output.pictures=true --set output.picture_width=10",
+              "output.picture_width", NULL);
   /* an ellipsoid's semi_z set below 0 */
   run_refused("run " SP_SOURCE_DIR "/tests/scenes/two_spheres_ellipsoid.yaml --quiet --out "
               "test_scene_3d_out --set mesh.semi_z=-1",
