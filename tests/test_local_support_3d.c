@@ -53,22 +53,7 @@ static sp_run_summary run(int n_set, const char **set, const char *out, double *
 /** cells.csv of @p out: per step and cell the values of column @p name
  *  (NAN where the cell does not exist); returns the number of steps + 1. */
 static int read_cells(const char *out, const char *name, double (*v)[MAX_CELLS]) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/cells.csv", out);
-  csv_table t;
-  CHECK(csv_read(path, &t) == 0, "%s missing", path);
-  for (int s = 0; s < CAP; ++s)
-    for (int k = 0; k < MAX_CELLS; ++k) v[s][k] = NAN;
-  int steps = 0;
-  for (int i = 0; i < t.n_rows; ++i) {
-    const int s = (int)at(&t, i, "step"), k = (int)at(&t, i, "cell") - 1;
-    CHECK(s >= 0 && s < CAP && k >= 0 && k < MAX_CELLS, "row %d: step %d cell %d", i, s, k + 1);
-    if (s < 0 || s >= CAP || k < 0 || k >= MAX_CELLS) continue;
-    v[s][k] = at(&t, i, name);
-    if (s + 1 > steps) steps = s + 1;
-  }
-  free(t.v);
-  return steps;
+  return cells_column(out, name, &v[0][0], CAP, MAX_CELLS);
 }
 
 static double rel(double a, double b) { return fabs(b - a) / fabs(a); }
