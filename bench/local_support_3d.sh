@@ -1,34 +1,28 @@
 #!/usr/bin/env bash
 # Full against local supports on the 3D run 5 (inputs/3d/embryo_8.yaml,
-# issue 29): the same run with each layout, and per number of cells the
+# issue 29): the same run with each layout (bench/lib.sh ab_runs: wall
+# time, peak memory, the largest unknown count, per-step iterations and
+# factorisations, the runs' agreement), then per number of cells the
 # steps, the simulated time they cover, wall seconds per step (and its
 # assembly, factorisation, solves, support changes) and per 0.001 of
-# simulated time, unknowns per step and per cell; then the totals (wall
-# time, peak memory, largest unknown count) and what the two runs agree on
-# (bench/lib.sh compare_runs).
+# simulated time, unknowns per step and per cell.
 #   bench/local_support_3d.sh [REFINEMENTS] [--set k=v ...]
 # REFINEMENTS: mesh.refinements (default 3: 4589 nodes with the buffer).
 # Without --set the runs go to the scene's t_end (1 -> 8 cells); e.g.
-# --set time.max_steps=20 stops both after 20 steps.
-# SOFTPACK=path runs another binary; OUT=dir keeps both runs (dir/full,
-# dir/local; otherwise a temporary directory, removed at the end).
+# --set time.max_steps=20 stops both after 20 steps. NP=2 runs each on
+# two processes; SOFTPACK=path runs another binary; OUT=dir keeps both
+# runs (dir/full, dir/local; otherwise a temporary directory, removed at
+# the end).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . bench/lib.sh
 scene=inputs/3d/embryo_8.yaml
 refinements=${1:-3}
 shift || true
-bin=${SOFTPACK:-build/softpack}
 out=${OUT:-$(mktemp -d)}
-[ -n "${OUT:-}" ] || trap 'rm -rf "$out"' EXIT
-mkdir -p "$out"
-export OMP_NUM_THREADS=1
 echo "$scene, mesh.refinements=$refinements $*; $(date -u '+%Y-%m-%d %H:%M UTC'), $(nproc --all) cores"
-for mode in full local; do
-  /usr/bin/time -f "%e %M" -o "$out/$mode.time" "$bin" run "$scene" --out "$out/$mode" \
-      --set mesh.refinements="$refinements" --set layout.support=$mode "$@" > "$out/$mode.log" 2>&1 ||
-    { echo "$mode run failed:"; tail -5 "$out/$mode.log"; exit 1; }
-done
+OUT=$out ab_runs "$scene" full layout.support=full local layout.support=local \
+  --set mesh.refinements="$refinements" "$@"
 echo
 echo "| supports | cells | steps | t covered | s/step | assembly | factorisation | solves | supports | s per 0.001 of t | unknowns/step | unknowns/cell | support changes |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
@@ -44,15 +38,4 @@ for mode in full local; do
                    su[n] / k[n], 1e-3 * sec[n] / dt[n], u[n] / k[n], u[n] / k[n] / n, ch[n] } }' \
     "$out/$mode/energy.csv"
 done
-echo
-echo "| supports | steps | t reached | wall s | peak MB | largest unknowns |"
-echo "|---|---|---|---|---|---|"
-for mode in full local; do
-  read -r wall mem < "$out/$mode.time"
-  awk -F, -v mode="$mode" -v wall="$wall" -v mem="$mem" 'NR == 1 { for (j = 1; j <= NF; ++j) c[$j] = j; next }
-    { s = $1; t = $2; if ($c["unknowns"] > u) u = $c["unknowns"] }
-    END { printf "| %s | %d | %.6g | %.1f | %.0f | %d |\n", mode, s, t, wall, mem / 1024, u }' \
-    "$out/$mode/energy.csv"
-done
-echo
-compare_runs "$out/full" "$out/local"
+[ -n "${OUT:-}" ] || rm -rf "$out"
