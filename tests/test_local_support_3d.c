@@ -17,7 +17,9 @@
  *    cell masses agree to the scene's time tolerance time.rtol (relative)
  *    and the centres to time.rtol of an element; the default margin's
  *    difference (the cut far field: docs/local-support.md, "In 3D") is
- *    printed. */
+ *    printed;
+ *  - layout.support: auto is local when divisions can make more than 4
+ *    cells and full when they cannot, as in 2D. */
 #include <string.h>
 
 #include "check.h"
@@ -166,7 +168,7 @@ static void differences(const char *a, const char *b, int steps, double *d_energ
   }
   for (int s = 0; s <= steps; ++s)
     for (int k = 0; k < MAX_CELLS; ++k) {
-      if (isnan(ma[s][k]) != isnan(mb[s][k])) CHECK(0, "step %d: cell %d in one run only", s, k);
+      if (isnan(ma[s][k]) != isnan(mb[s][k])) CHECK(0, "step %d: cell %d in one run only", s, k + 1);
       if (isnan(ma[s][k]) || isnan(mb[s][k])) continue;
       *d_mass = fmax(*d_mass, rel(ma[s][k], mb[s][k]));
       double dist2 = 0;
@@ -204,8 +206,25 @@ static void test_against_full(void) {
   CHECK(dx <= rtol * h, "centres differ by %.3g (time.rtol x element %g)", dx, rtol * h);
 }
 
+/* layout.support: auto in 3D as in 2D: local when divisions can make
+ * more than 4 cells (N_max from the box's volume, 0.36 / 0.0177 ~ 20),
+ * full when they cannot (max_cells 4); one step each. */
+static void test_auto(void) {
+  const char *more[] = {"layout.support=auto", "division.max_cells=0", "time.max_steps=1"};
+  const char *four[] = {"layout.support=auto", "division.max_cells=4", "time.max_steps=1"};
+  const long full_unknowns = 2L * 21 * 13 * 13; /* one cell on every node */
+  const sp_run_summary a = run(3, more, "local_3d_auto", NULL, NULL);
+  const sp_run_summary b = run(3, four, "local_3d_auto4", NULL, NULL);
+  CHECK(a.unknowns_max > 0 && a.unknowns_max < full_unknowns,
+        "auto with N_max > 4: %ld unknowns, the full layout has %ld", a.unknowns_max,
+        full_unknowns);
+  CHECK(b.unknowns_max == full_unknowns, "auto with N_max = 4: %ld unknowns, full %ld",
+        b.unknowns_max, full_unknowns);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
+  test_auto();
   test_laws();
   test_against_full(); /* (reads test_laws' run) */
   MPI_Finalize();
