@@ -20,6 +20,7 @@ struct sp_support_s {
   /* scratch marks, n_nodes each, all 0 between calls: a candidate support
    * and the nodes of its whole elements (closing a support) */
   unsigned char *member, *kept;
+  int outgrown_reported; /* sp_support_first_outgrown said so once */
 };
 
 /** Per-cell node lists being built (CSR: cell k's nodes are
@@ -316,6 +317,16 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout, const double 
     for (int64_t j = j0; j < j1; ++j) s->member[cp->cell_node[j]] = 0;
   }
   *needed = grow;
+  return SP_OK;
+}
+
+int sp_support_first_outgrown(sp_support s, const sp_layout *layout, const double *state,
+                              int *first) {
+  *first = 0;
+  if (s->outgrown_reported) return SP_OK;
+  int outgrown = 0;
+  SP_CALL(sp_support_needs_update(s, layout, state, &outgrown));
+  *first = s->outgrown_reported = outgrown;
   return SP_OK;
 }
 
