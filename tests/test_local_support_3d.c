@@ -19,14 +19,22 @@
  *    difference (the cut far field: docs/local-support.md, "In 3D") is
  *    printed;
  *  - layout.support: auto is local when divisions can make more than 4
- *    cells and full when they cannot, as in 2D. */
+ *    cells and full when they cannot, as in 2D;
+ *  - the coarse-mesh check (sp_support_first_outgrown): supports built
+ *    from a sphere of radius 0.24 in the ellipsoid 0.5 x 0.25 x 0.25
+ *    (kappa 1e-3, margin 8 d, band 4 d) need an update right after they
+ *    are built at refinements 3 (elements up to 0.107 > margin - band =
+ *    0.044), said once; not with margin 12 d, nor at refinements 4. */
 #include <string.h>
 
 #include "check.h"
 #include "error.h"
+#include "layout.h"
+#include "mesh.h"
 #include "output_read.h"
 #include "scene.h"
 #include "stepper.h"
+#include "support.h"
 
 #define SCENE SP_SOURCE_DIR "/tests/scenes/local_divide_3d.yaml"
 
@@ -222,8 +230,61 @@ static void test_auto(void) {
         b.unknowns_max, full_unknowns);
 }
 
+/** Supports of one tanh sphere of radius 0.24 on the 3D run 5's
+ *  ellipsoid at @p refinements, built from the field (the set-up's masks)
+ *  and rebuilt once; sp_support_first_outgrown on the rebuilt ones, called
+ *  twice: *first and *again. */
+static void coarse_rule(int refinements, double margin, int *first, int *again) {
+  sp_mesh *mesh;
+  CHECK_OK(sp_mesh_ellipsoid(refinements, 0.5, 0.25, 0.25, 2, 0.1, &mesh));
+  if (sp_test_failures) return;
+  const int nn = mesh->n_nodes;
+  const double kappa = 1e-3, alpha = 4, d = sqrt(kappa / (2 * alpha));
+  sp_layout *full, *layout, *rebuilt;
+  CHECK_OK(sp_layout_create_full(nn, 1, &full));
+  double *state = calloc(2 * (size_t)nn, sizeof(double));
+  for (int i = 0; i < nn; ++i) {
+    const double *x = mesh->xy + 3 * i;
+    state[2 * i] = 1 / (1 + exp((sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) - 0.24) / d));
+  }
+  const sp_support_params p = {.margin = margin * d, .core_threshold = 0.1,
+                               .grow_threshold = 0.2, .band = 4 * d, .alpha = alpha,
+                               .kappa = kappa, .lambda = 100, .lambda_b = 100,
+                               .fill = SP_SUPPORT_FILL_EDGE};
+  sp_support s;
+  CHECK_OK(sp_support_create(mesh, &p, &s));
+  unsigned char *mask = calloc((size_t)nn, 1);
+  CHECK_OK(sp_support_masks(s, full, state, mask));
+  CHECK_OK(sp_support_layout_from_masks(s, 1, mask, &layout));
+  double *local = calloc(2 * (size_t)layout->n_pairs, sizeof(double)), *next, correction,
+         dropped;
+  sp_layout_transfer(full, state, layout, local, 0.0);
+  CHECK_OK(sp_support_rebuild(s, layout, local, NULL, &rebuilt, &next, &correction, &dropped));
+  CHECK_OK(sp_support_first_outgrown(s, rebuilt, next, first));
+  CHECK_OK(sp_support_first_outgrown(s, rebuilt, next, again));
+  printf("coarse rule: refinements %d (elements up to %.3f), margin %g d, band 4 d: %d of %d "
+         "nodes; outgrown right after the rebuild: %d, asked again: %d\n", refinements, mesh->h,
+         margin, rebuilt->n_pairs, nn, *first, *again);
+  free(state); free(mask); free(local); free(next);
+  sp_layout_destroy(&full); sp_layout_destroy(&layout); sp_layout_destroy(&rebuilt);
+  sp_support_destroy(&s);
+  sp_mesh_destroy(&mesh);
+}
+
+static void test_coarse_rule(void) {
+  int first, again;
+  coarse_rule(3, 8, &first, &again);
+  CHECK(first == 1 && again == 0, "refinements 3, margin 8 d: told %d, then %d (1, 0)", first,
+        again);
+  coarse_rule(3, 12, &first, &again);
+  CHECK(first == 0, "refinements 3, margin 12 d: outgrown");
+  coarse_rule(4, 8, &first, &again);
+  CHECK(first == 0, "refinements 4, margin 8 d: outgrown");
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
+  test_coarse_rule();
   test_auto();
   test_laws();
   test_against_full(); /* (reads test_laws' run) */
