@@ -14,9 +14,6 @@
  *  that branch can reach, the equation's other root is a new cell's
  *  interior, which the field beyond the edge does not become in a step. */
 #define SP_FAR_FIELD_SPINODAL 0.21132486540518711775
-/** The far field is relaxed on 2D meshes only (local supports, support.c,
- *  are refused on a 3D mesh): quadrilaterals, 4 nodes and 4 Gauss points. */
-#define SP_FAR_NODES 4
 
 /** One new pair's row of the far-field equations: sum_b K_ab v_b over the
  *  elements whole for its cell (off-diagonal entries by pair), K_aa,
@@ -36,26 +33,33 @@ typedef struct {
 
 /** Element e is whole for cell k in @p to: every node carries k. */
 static int whole(const sp_mesh *mesh, const sp_layout *to, int e, int k) {
-  for (int a = 0; a < SP_FAR_NODES; ++a)
-    if (sp_layout_pair(to, k, mesh->elem[SP_FAR_NODES * e + a]) < 0)
+  const int nen = mesh->nodes_per_elem;
+  for (int a = 0; a < nen; ++a)
+    if (sp_layout_pair(to, k, mesh->elem[(size_t)nen * e + a]) < 0)
       return 0;
   return 1;
 }
 
-/** Element e's stiffness row of local node a and its lumped mass there. */
-static void element_row(const sp_mesh *mesh, int e, int a, double k_row[SP_FAR_NODES],
+/** Element e's stiffness row of local node a and its lumped mass there
+ *  (the mesh's Q1 element and Gauss rule, q1.h). */
+static void element_row(const sp_mesh *mesh, int e, int a, double k_row[SP_Q1_MAX_NODES],
                         double *mass) {
   double xy[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], N[SP_Q1_MAX_NODES],
       dNdx[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], x[SP_Q1_MAX_DIM], w;
+  const int dim = mesh->dim, nen = mesh->nodes_per_elem;
   sp_mesh_elem_xy(mesh, e, xy);
   *mass = 0;
-  for (int b = 0; b < SP_FAR_NODES; ++b)
+  for (int b = 0; b < nen; ++b)
     k_row[b] = 0;
-  for (int q = 0; q < sp_q1_qpoints(2); ++q) {
-    sp_q1_point(2, xy, q, N, dNdx, x, &w);
+  for (int q = 0; q < sp_q1_qpoints(dim); ++q) {
+    sp_q1_point(dim, xy, q, N, dNdx, x, &w);
     *mass += w * N[a];
-    for (int b = 0; b < SP_FAR_NODES; ++b)
-      k_row[b] += w * (dNdx[a][0] * dNdx[b][0] + dNdx[a][1] * dNdx[b][1]);
+    for (int b = 0; b < nen; ++b) {
+      double grad_dot = 0; /* (0 + x = x: in 2D the sum of two products as before) */
+      for (int d = 0; d < dim; ++d)
+        grad_dot += dNdx[a][d] * dNdx[b][d];
+      k_row[b] += w * grad_dot;
+    }
   }
 }
 
@@ -68,17 +72,18 @@ static int build_row(const sp_mesh *mesh, const int *ne_start, const int *ne_lis
     const int e = ne_list[t];
     if (!whole(mesh, to, e, k))
       continue;
-    const int *nodes = mesh->elem + SP_FAR_NODES * e;
+    const int nen = mesh->nodes_per_elem;
+    const int *nodes = mesh->elem + (size_t)nen * e;
     int a = 0;
     while (nodes[a] != i)
       ++a;
-    double k_row[SP_FAR_NODES], m;
+    double k_row[SP_Q1_MAX_NODES], m;
     element_row(mesh, e, a, k_row, &m);
     r->k_diag += k_row[a];
     r->mass += m;
     if (mesh->region && mesh->region[e] == SP_REGION_BUFFER)
       r->mass_buffer += m;
-    for (int b = 0; b < SP_FAR_NODES; ++b) {
+    for (int b = 0; b < nen; ++b) {
       if (b == a)
         continue;
       R->entry_pair[*n_entries] = sp_layout_pair(to, k, nodes[b]);
@@ -102,7 +107,7 @@ static int rows_build(const sp_mesh *mesh, const int *ne_start, const int *ne_li
     for (int q = to->node_start[i]; q < to->node_start[i + 1]; ++q)
       if (is_new[q]) {
         ++n_rows;
-        cap += (SP_FAR_NODES - 1) * (int64_t)(ne_start[i + 1] - ne_start[i]);
+        cap += (mesh->nodes_per_elem - 1) * (int64_t)(ne_start[i + 1] - ne_start[i]);
       }
   SP_ALLOC(R->row, n_rows);
   SP_ALLOC(R->entry_pair, cap);
@@ -159,8 +164,6 @@ static double update(const sp_far_field_params *p, const far_row *r, const far_r
 int sp_far_field_relax(const sp_mesh *mesh, const int *ne_start, const int *ne_list,
                        const sp_far_field_params *params, const sp_layout *to,
                        const unsigned char *is_new, double *state, int *sweeps) {
-  SP_CHECK(mesh->dim == 2 && mesh->nodes_per_elem == SP_FAR_NODES, SP_ERR_INPUT,
-           "layout.fill = relax: the far field is not yet on a 3D mesh (issue 29)");
   far_rows R = {0};
   int rc = rows_build(mesh, ne_start, ne_list, to, is_new, &R);
   int n = 0;

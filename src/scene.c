@@ -273,8 +273,8 @@ static const sp_key sp_keys[] = {
     /* mesh */
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
              "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
-             "or an ellipsoid of hexahedra (3D; not yet with divisions, the shape "
-             "term, local supports or initial files: issue 29)"),
+             "or an ellipsoid of hexahedra (3D; not yet with the shape "
+             "term or initial files: issue 29)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
               "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
@@ -1553,8 +1553,8 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
 #define SP_NOT_YET_3D "not yet in 3D (mesh.type box, ellipsoid; issue 29)"
 
 /** What a scene on a 3D mesh cannot ask for yet, each refused naming its
- *  key, rather than run wrong: the shape term, local supports and
- *  initial fields from files. */
+ *  key, rather than run wrong: the shape term and initial fields from
+ *  files. */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
   SP_CHECK(scene->n_lineage == 0, SP_ERR_INPUT,
@@ -1565,23 +1565,6 @@ static int check_3d(const sp_scene *scene, const char *file) {
   SP_CHECK(scene->shape.delta2 == 0, SP_ERR_INPUT,
            "%s: shape.delta2: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
            scene->shape.delta2);
-  /* layout.support auto is local beyond 4 cells (run_setup.c) */
-  SP_CHECK(scene->layout.support == SP_SUPPORT_FULL ||
-               (scene->layout.support == SP_SUPPORT_AUTO && scene->n_cells <= 4),
-           SP_ERR_INPUT,
-           "%s: layout.support: local supports are " SP_NOT_YET_3D
-           ": expected full (auto is local beyond 4 cells; the scene has %d)",
-           file, scene->n_cells);
-  /* ... or when divisions can make more than 4 (N_max from the volume is
-   * only known with the mesh: then full must be asked for) */
-  const int max_cells = scene->division.max_cells;
-  SP_CHECK(scene->layout.support == SP_SUPPORT_FULL ||
-               scene->division.criterion == SP_DIVIDE_NONE || (max_cells >= 1 && max_cells <= 4),
-           SP_ERR_INPUT,
-           "%s: layout.support: local supports are " SP_NOT_YET_3D
-           ": expected full for a scene with divisions (auto is local when divisions can make "
-           "more than 4 cells; division.max_cells = %d, 0: from the volume)",
-           file, max_cells);
   SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
            "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
            ": expected none, got '%s'", file, scene->initial.from);

@@ -20,6 +20,7 @@ struct sp_support_s {
   /* scratch marks, n_nodes each, all 0 between calls: a candidate support
    * and the nodes of its whole elements (closing a support) */
   unsigned char *member, *kept;
+  int outgrown_reported; /* sp_support_first_outgrown said so once */
 };
 
 /** Per-cell node lists being built (CSR: cell k's nodes are
@@ -33,15 +34,15 @@ typedef struct {
 /** The elements around each node (s->ne_start, s->ne_list). */
 static int node_elements(struct sp_support_s *s) {
   const sp_mesh *mesh = s->mesh;
-  const int nn = mesh->n_nodes, ne = mesh->n_elems;
+  const int nn = mesh->n_nodes, ne = mesh->n_elems, nen = mesh->nodes_per_elem;
   for (int e = 0; e < ne; ++e)
-    for (int a = 0; a < 4; ++a) ++s->ne_start[mesh->elem[4 * e + a] + 1];
+    for (int a = 0; a < nen; ++a) ++s->ne_start[mesh->elem[(size_t)nen * e + a] + 1];
   for (int i = 0; i < nn; ++i) s->ne_start[i + 1] += s->ne_start[i];
   int *fill;
   SP_ALLOC(fill, nn);
   for (int e = 0; e < ne; ++e) {
-    for (int a = 0; a < 4; ++a) {
-      int n = mesh->elem[4 * e + a];
+    for (int a = 0; a < nen; ++a) {
+      int n = mesh->elem[(size_t)nen * e + a];
       s->ne_list[s->ne_start[n] + fill[n]++] = e;
     }
   }
@@ -50,8 +51,6 @@ static int node_elements(struct sp_support_s *s) {
 }
 
 int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_support *out) {
-  SP_CHECK(mesh->dim == 2, SP_ERR_INPUT,
-           "layout.support: local supports are not yet on a 3D mesh (issue 29)");
   SP_CHECK(params->margin > 0 && params->band > 0 && params->band < params->margin,
            SP_ERR_INPUT, "layout: need 0 < band (%g) < margin (%g)", params->band,
            params->margin);
@@ -62,7 +61,7 @@ int sp_support_create(const sp_mesh *mesh, const sp_support_params *params, sp_s
   s->params = *params;
   const int nn = mesh->n_nodes, ne = mesh->n_elems;
   SP_ALLOC(s->ne_start, nn + 1);
-  SP_ALLOC(s->ne_list, 4 * (size_t)ne);
+  SP_ALLOC(s->ne_list, (size_t)mesh->nodes_per_elem * ne);
   SP_ALLOC(s->source, nn);
   SP_ALLOC(s->queue, nn);
   SP_ALLOC(s->best, nn);
@@ -86,8 +85,20 @@ void sp_support_destroy(sp_support *s) {
   *s = NULL;
 }
 
+/** The straight distance between nodes i and j in the mesh's dimension,
+ *  accumulated by hypot one coordinate at a time: hypot(0, dx) = |dx|, so
+ *  in 2D this is hypot(dx, dy) exactly. */
 static double node_distance(const sp_mesh *m, int i, int j) {
-  return hypot(m->xy[2 * i] - m->xy[2 * j], m->xy[2 * i + 1] - m->xy[2 * j + 1]);
+  const int dim = m->dim;
+  const double *xi = m->xy + (size_t)dim * i, *xj = m->xy + (size_t)dim * j;
+  double r = 0;
+  for (int d = 0; d < dim; ++d) r = hypot(r, xi[d] - xj[d]);
+  return r;
+}
+
+/** Element e's nodes (mesh->nodes_per_elem of them). */
+static const int *element_nodes(const sp_mesh *m, int e) {
+  return m->elem + (size_t)m->nodes_per_elem * e;
 }
 
 /**
@@ -110,8 +121,8 @@ static int grow_from_seeds(sp_support s, int n_seeds, double radius,
   while (head < tail) {
     const int i = s->queue[head++];
     for (int t = s->ne_start[i]; t < s->ne_start[i + 1]; ++t) {
-      const int *nodes = m->elem + 4 * s->ne_list[t];
-      for (int a = 0; a < 4; ++a) {
+      const int *nodes = element_nodes(m, s->ne_list[t]);
+      for (int a = 0; a < m->nodes_per_elem; ++a) {
         const int j = nodes[a];
         if (allowed && !allowed[j]) continue;
         const double d = node_distance(m, j, s->source[i]);
@@ -174,10 +185,18 @@ static int lists_push(cell_lists *L, int n_cells_done, int i) {
   return SP_OK;
 }
 
+/** Every node of element e is marked in s->member. */
+static int all_members(sp_support s, int e) {
+  const int *nodes = element_nodes(s->mesh, e);
+  for (int a = 0; a < s->mesh->nodes_per_elem; ++a)
+    if (!s->member[nodes[a]]) return 0;
+  return 1;
+}
+
 /**
  * Close the candidate support s->queue[0..n) (marked in s->member) to whole
  * elements, the solver's rule: its nodes that belong to an element whose
- * four nodes are all candidates. They are appended to @p L as cell
+ * nodes (4 or 8) are all candidates. They are appended to @p L as cell
  * @p k's list; the marks are cleared. Costs the candidates' elements.
  */
 static int close_to_elements(sp_support s, int n, int k, cell_lists *L) {
@@ -186,11 +205,9 @@ static int close_to_elements(sp_support s, int n, int k, cell_lists *L) {
   L->start[k + 1] = L->start[k];
   for (int q = 0; q < n && rc == SP_OK; ++q)
     for (int t = s->ne_start[s->queue[q]]; t < s->ne_start[s->queue[q] + 1]; ++t) {
-      const int *nodes = m->elem + 4 * s->ne_list[t];
-      if (!(s->member[nodes[0]] && s->member[nodes[1]] && s->member[nodes[2]] &&
-            s->member[nodes[3]]))
-        continue;
-      for (int a = 0; a < 4 && rc == SP_OK; ++a)
+      if (!all_members(s, s->ne_list[t])) continue;
+      const int *nodes = element_nodes(m, s->ne_list[t]);
+      for (int a = 0; a < m->nodes_per_elem && rc == SP_OK; ++a)
         if (!s->kept[nodes[a]]) {
           s->kept[nodes[a]] = 1;
           rc = lists_push(L, k, nodes[a]);
@@ -267,8 +284,8 @@ int sp_support_layout(sp_support s, const sp_layout *layout, const double *state
  *  whole for cell k. */
 static int on_edge(sp_support s, const sp_layout *layout, int k, int i) {
   for (int t = s->ne_start[i]; t < s->ne_start[i + 1]; ++t) {
-    const int *nodes = s->mesh->elem + 4 * s->ne_list[t];
-    for (int a = 0; a < 4; ++a)
+    const int *nodes = element_nodes(s->mesh, s->ne_list[t]);
+    for (int a = 0; a < s->mesh->nodes_per_elem; ++a)
       if (sp_layout_pair(layout, k, nodes[a]) < 0) return 1;
   }
   return 0;
@@ -300,6 +317,16 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout, const double 
     for (int64_t j = j0; j < j1; ++j) s->member[cp->cell_node[j]] = 0;
   }
   *needed = grow;
+  return SP_OK;
+}
+
+int sp_support_first_outgrown(sp_support s, const sp_layout *layout, const double *state,
+                              int *first) {
+  *first = 0;
+  if (s->outgrown_reported) return SP_OK;
+  int outgrown = 0;
+  SP_CALL(sp_support_needs_update(s, layout, state, &outgrown));
+  *first = s->outgrown_reported = outgrown;
   return SP_OK;
 }
 

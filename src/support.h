@@ -70,6 +70,18 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout,
                             const double *state, int *needed);
 
 /**
+ * @brief Whether supports just rebuilt from @p state already need an
+ *        update (sp_support_needs_update on the new layout and state),
+ *        told once per sp_support: a support closed to whole elements can
+ *        lose up to an element's width of its margin, so where elements
+ *        are wider than margin - band the rule asks for a change at every
+ *        step (docs/local-support.md, "Coarse meshes").
+ * @param[out] first 1 the first time this holds, else 0
+ */
+int sp_support_first_outgrown(sp_support s, const sp_layout *layout, const double *state,
+                              int *first);
+
+/**
  * @brief The values of @p state (on @p layout) on the layout @p to, each
  *        cell's mass not yet restored: kept pairs by (cell, node), new
  *        pairs the far field continued from the old edge

@@ -109,6 +109,29 @@ static inline double cells_mass_at(const char *path, int step, int cap, int *n_c
   return total;
 }
 
+/** Column @p name of @p dir/cells.csv as a table by step and cell: v[s *
+ *  n_cells + k] is cell k + 1's value at step s (NAN where it does not
+ *  exist), s < cap and k < n_cells (a row beyond them fails a check);
+ *  returns the number of steps + 1. */
+static inline int cells_column(const char *dir, const char *name, double *v, int cap,
+                               int n_cells) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/cells.csv", dir);
+  csv_table t;
+  CHECK(csv_read(path, &t) == 0, "%s missing", path);
+  for (int i = 0; i < cap * n_cells; ++i) v[i] = NAN;
+  int steps = 0;
+  for (int i = 0; i < t.n_rows; ++i) {
+    const int s = (int)at(&t, i, "step"), k = (int)at(&t, i, "cell") - 1;
+    CHECK(s >= 0 && s < cap && k >= 0 && k < n_cells, "row %d: step %d cell %d", i, s, k + 1);
+    if (s < 0 || s >= cap || k < 0 || k >= n_cells) continue;
+    v[s * n_cells + k] = at(&t, i, name);
+    if (s + 1 > steps) steps = s + 1;
+  }
+  free(t.v);
+  return steps;
+}
+
 /* The whole file as a string (NULL if unreadable); its length in *len. */
 static inline char *slurp(const char *path, size_t *len) {
   FILE *f = fopen(path, "rb");

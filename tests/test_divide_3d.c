@@ -79,21 +79,7 @@ static int read_division(const char *out, double axis[3], double *halves) {
 /** cells.csv of @p out: per step and cell the values of @p name (NAN where
  *  the cell does not exist); the number of steps + 1. */
 static int read_cells(const char *out, const char *name, double (*v)[MAX_CELLS], int cap) {
-  char path[512];
-  snprintf(path, sizeof path, "%s/cells.csv", out);
-  csv_table t;
-  CHECK(csv_read(path, &t) == 0, "%s missing", path);
-  for (int s = 0; s < cap; ++s) v[s][0] = v[s][1] = NAN;
-  int steps = 0;
-  for (int i = 0; i < t.n_rows; ++i) {
-    const int s = (int)at(&t, i, "step"), k = (int)at(&t, i, "cell") - 1;
-    CHECK(s >= 0 && s < cap && k >= 0 && k < MAX_CELLS, "row %d: step %d cell %d", i, s, k + 1);
-    if (s < 0 || s >= cap || k < 0 || k >= MAX_CELLS) continue;
-    v[s][k] = at(&t, i, name);
-    if (s + 1 > steps) steps = s + 1;
-  }
-  free(t.v);
-  return steps;
+  return cells_column(out, name, &v[0][0], cap, MAX_CELLS);
 }
 
 /** Relative change of a mass from one row to the next. */

@@ -7,7 +7,8 @@
  *   containing the key named in its first line, "# expect: <key>";
  * - missing, unreadable and empty files fail the same way;
  * - docs/scene.md holds exactly the table sp_scene_print_keys prints;
- * - every scene shipped under inputs/ and inputs/paper/ loads;
+ * - every scene shipped under inputs/, inputs/paper/, inputs/embryo/ and
+ *   inputs/3d/ loads;
  * - sp_scene_load_text reads text as sp_scene_load reads the file, and
  *   names the given name in its messages;
  * - a scene whose initial layout (nodes x cells pairs, 2 x pairs unknowns)
@@ -359,8 +360,9 @@ static int load_dir(const char *relative) {
 }
 
 static void test_shipped_scenes(void) {
-  const int n = load_dir("inputs") + load_dir("inputs/paper") + load_dir("inputs/embryo");
-  CHECK(n >= 11, "only %d scenes under inputs/", n);
+  const int n = load_dir("inputs") + load_dir("inputs/paper") + load_dir("inputs/embryo") +
+                load_dir("inputs/3d");
+  CHECK(n >= 12, "only %d scenes under inputs/", n);
 }
 
 /* tests/scenes/bad/too_many_pairs.yaml: 64 cells on a rectangle. The limit is

@@ -7,11 +7,11 @@
  *  - bad 3D input is refused as bad input (SP_ERR_INPUT) with a message
  *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
  *    the box, a z on a 2D mesh, and each feature not yet in 3D (shape
- *    term, local supports explicit or by auto with 5 cells or with
- *    divisions that can make more than 4, initial fields from files)
- *    with "not yet"; pictures and checkpoints load;
- *  - divisions load in 3D (phase 2) with layout.support full, or auto with
- *    division.max_cells <= 4;
+ *    term, initial fields from files) with "not yet"; pictures and
+ *    checkpoints load;
+ *  - divisions load in 3D (phase 2) with any layout.support, and so do
+ *    local supports (explicit, or auto with 5 cells or with divisions that
+ *    can make more than 4), as in 2D;
  *  - `softpack run` of such a scene exits 2, names the key and writes
  *    nothing. */
 #include <string.h>
@@ -79,21 +79,27 @@ int main(void) {
   refused(box, "  - {x: 0.3, y: 0.25, z: 0.35, radius: 0.1}\n", "cells[1].radius", "sphere");
   refused(box, "  - {x: 0.3, y: 0.25, z: 0.5, radius: 0.1}\n", "cells[1].z", "outside");
   refused("mesh: {type: rectangle, x1: 0.6, y1: 0.5}\n", "", "cells[0].z", "3D mesh");
-  refused(NULL, "division: {criterion: age}\n", "layout.support", "not yet in 3D");
-  refused(NULL, "division: {criterion: mass, max_cells: 5}\n", "layout.support", "not yet in 3D");
   const char *divides[] = {"division: {criterion: age}\nlayout: {support: full}\n",
-                           "division: {criterion: mass, max_cells: 4}\n"};
-  for (int i = 0; i < 2; ++i) {
+                           "division: {criterion: mass, max_cells: 4}\n",
+                           "division: {criterion: age}\n",
+                           "division: {criterion: mass, max_cells: 5}\nlayout: {support: local}\n"};
+  for (int i = 0; i < 4; ++i) {
     CHECK_OK(load(NULL, divides[i], &scene));
     CHECK(scene->division.criterion != SP_DIVIDE_NONE, "%s: no division", divides[i]);
     sp_scene_destroy(&scene);
   }
   refused(NULL, "shape: {delta2: 1e5}\n", "shape.delta2", "not yet in 3D");
-  refused(NULL, "layout: {support: local}\n", "layout.support", "not yet in 3D");
-  refused(NULL,
-          "  - {x: 0.1, y: 0.1, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.1, z: 0.0, radius: 0.05}\n"
-          "  - {x: 0.1, y: 0.4, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.4, z: 0.0, radius: 0.05}\n",
-          "layout.support", "not yet in 3D");
+  /* local supports, explicit or by auto with 5 cells */
+  CHECK_OK(load(NULL, "layout: {support: local}\n", &scene));
+  CHECK(scene->layout.support == SP_SUPPORT_LOCAL, "layout.support %d", scene->layout.support);
+  sp_scene_destroy(&scene);
+  CHECK_OK(load(NULL,
+                "  - {x: 0.1, y: 0.1, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.1, z: 0.0, radius: 0.05}\n"
+                "  - {x: 0.1, y: 0.4, z: 0.0, radius: 0.05}\n  - {x: 0.5, y: 0.4, z: 0.0, radius: 0.05}\n",
+                &scene));
+  CHECK(scene->n_cells == 5 && scene->layout.support == SP_SUPPORT_AUTO, "%d cells, support %d",
+        scene->n_cells, scene->layout.support);
+  sp_scene_destroy(&scene);
   /* pictures are 3D too (render.c: sections and surfaces) */
   CHECK_OK(load(NULL, "output: {pictures: true}\n", &scene));
   CHECK(scene->output.pictures == 1, "pictures %d", scene->output.pictures);
