@@ -62,14 +62,25 @@ static void volume_to_grid(const sp_label_grid *g, const double *x, double *at) 
             g->to_ijk[a][3];
 }
 
-static int cmp_u32(const void *a, const void *b) {
-  const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-  return (x > y) - (x < y);
-}
-
 static int cmp_double(const void *a, const void *b) {
   const double x = *(const double *)a, y = *(const double *)b;
   return (x > y) - (x < y);
+}
+
+/** Sort @p v (n values) and keep each value once, ascending: the labels
+ *  (colours, voxel values; exact in a double); returns how many. */
+static int distinct_labels(double *v, size_t n) {
+  qsort(v, n, sizeof *v, cmp_double);
+  int k = 0;
+  for (size_t i = 0; i < n; ++i)
+    if (i == 0 || v[i] != v[i - 1]) v[k++] = v[i];
+  return k;
+}
+
+/** The index of label value @p x among the @p n distinct ones. */
+static int label_index(double x, const double *distinct, int n) {
+  const double *at = bsearch(&x, distinct, (size_t)n, sizeof *distinct, cmp_double);
+  return (int)(at - distinct);
 }
 
 static int labels_load(const char *path, const sp_scene_initial *box, sp_label_grid *out) {
@@ -90,7 +101,7 @@ static int labels_load(const char *path, const sp_scene_initial *box, sp_label_g
     rc = sp_error_set(SP_ERR_INPUT, "initial.label_image: '%s': expected an RGB or RGBA PNG",
                       path);
   uint32_t *colour = rc == SP_OK ? malloc(sizeof(uint32_t) * (size_t)w * h + 4) : NULL;
-  uint32_t *sorted = rc == SP_OK ? malloc(sizeof(uint32_t) * (size_t)w * h + 4) : NULL;
+  double *sorted = rc == SP_OK ? malloc(sizeof(double) * (size_t)w * h + 8) : NULL;
   out->label = rc == SP_OK ? malloc(sizeof(int) * (size_t)w * h + 4) : NULL;
   if (rc == SP_OK && (!colour || !sorted || !out->label))
     rc = sp_error_set(SP_ERR_MEMORY, "out of memory reading '%s'", path);
@@ -103,23 +114,12 @@ static int labels_load(const char *path, const sp_scene_initial *box, sp_label_g
       colour[(size_t)y * w + x] = transparent ? 0 : rgb;
       if (!transparent && rgb != 0) sorted[n_fg++] = rgb;
     }
-  int n = 0;
-  if (rc == SP_OK) { /* the distinct colours, ascending */
-    qsort(sorted, n_fg, sizeof *sorted, cmp_u32);
-    for (size_t i = 0; i < n_fg; ++i)
-      if (i == 0 || sorted[i] != sorted[i - 1]) sorted[n++] = sorted[i];
-    if (n == 0)
-      rc = sp_error_set(SP_ERR_INPUT, "initial.label_image: '%s': no labels (every pixel is "
-                                      "black or transparent)", path);
-  }
-  for (size_t i = 0; rc == SP_OK && i < (size_t)w * h; ++i) {
-    if (colour[i] == 0) {
-      out->label[i] = -1;
-      continue;
-    }
-    const uint32_t *at = bsearch(&colour[i], sorted, (size_t)n, sizeof *sorted, cmp_u32);
-    out->label[i] = (int)(at - sorted);
-  }
+  const int n = rc == SP_OK ? distinct_labels(sorted, n_fg) : 0; /* colours, ascending */
+  if (rc == SP_OK && n == 0)
+    rc = sp_error_set(SP_ERR_INPUT, "initial.label_image: '%s': no labels (every pixel is "
+                                    "black or transparent)", path);
+  for (size_t i = 0; rc == SP_OK && i < (size_t)w * h; ++i)
+    out->label[i] = colour[i] == 0 ? -1 : label_index(colour[i], sorted, n);
   free(colour);
   free(sorted);
   cairo_surface_destroy(img);
@@ -163,6 +163,14 @@ static double voxel_value(const nifti_image *nim, size_t i) {
   }
 }
 
+/** Voxel @p i's label: its value scaled by scl_slope and scl_inter where
+ *  the file sets them (slope 0 means unset). */
+static double voxel_label(const nifti_image *nim, size_t i) {
+  const double v = voxel_value(nim, i);
+  const int scaled = nim->scl_slope != 0 && !(nim->scl_slope == 1 && nim->scl_inter == 0);
+  return scaled ? nim->scl_slope * v + nim->scl_inter : v;
+}
+
 /** Labels are integers below 2^53 (exact in a double). */
 #define SP_LABEL_MAX 9007199254740992.0
 
@@ -201,15 +209,13 @@ static int volume_affine(const nifti_image *nim, const char *path, double m[3][4
  *  distinct nonzero values, ascending (-1: 0, the background). */
 static int volume_labels(const nifti_image *nim, const char *path, sp_label_grid *g) {
   const size_t nv = g->n_samples;
-  const int scaled = nim->scl_slope != 0 && !(nim->scl_slope == 1 && nim->scl_inter == 0);
   double *sorted = malloc(sizeof(double) * nv + 8);
   g->label = malloc(sizeof(int) * nv + 4);
   SP_CHECK(sorted && g->label, SP_ERR_MEMORY, "out of memory reading '%s'", path);
   size_t n_fg = 0;
   int rc = SP_OK;
   for (size_t i = 0; i < nv; ++i) {
-    double v = voxel_value(nim, i);
-    if (scaled) v = nim->scl_slope * v + nim->scl_inter;
+    const double v = voxel_label(nim, i);
     if (!(isfinite(v) && v == floor(v) && v >= 0 && v < SP_LABEL_MAX)) {
       const size_t nx = (size_t)g->n[0], ny = (size_t)g->n[1];
       rc = sp_error_set(SP_ERR_INPUT, "initial.label_volume: '%s': voxel (%zu, %zu, %zu) holds "
@@ -220,21 +226,13 @@ static int volume_labels(const nifti_image *nim, const char *path, sp_label_grid
     g->label[i] = v == 0 ? -1 : 0;
     if (v != 0) sorted[n_fg++] = v;
   }
-  int n = 0;
-  if (rc == SP_OK) {
-    qsort(sorted, n_fg, sizeof *sorted, cmp_double);
-    for (size_t i = 0; i < n_fg; ++i)
-      if (i == 0 || sorted[i] != sorted[i - 1]) sorted[n++] = sorted[i];
-    if (n == 0)
-      rc = sp_error_set(SP_ERR_INPUT, "initial.label_volume: '%s': no labels (every voxel is "
-                                      "0): expected nonzero labels, one a cell", path);
-  }
+  const int n = rc == SP_OK ? distinct_labels(sorted, n_fg) : 0;
+  if (rc == SP_OK && n == 0)
+    rc = sp_error_set(SP_ERR_INPUT, "initial.label_volume: '%s': no labels (every voxel is "
+                                    "0): expected nonzero labels, one a cell", path);
   for (size_t i = 0; rc == SP_OK && i < nv; ++i) {
     if (g->label[i] < 0) continue;
-    double v = voxel_value(nim, i);
-    if (scaled) v = nim->scl_slope * v + nim->scl_inter;
-    const double *at = bsearch(&v, sorted, (size_t)n, sizeof *sorted, cmp_double);
-    g->label[i] = (int)(at - sorted);
+    g->label[i] = label_index(voxel_label(nim, i), sorted, n);
   }
   if (rc != SP_OK) {
     free(sorted);

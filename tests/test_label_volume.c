@@ -123,19 +123,16 @@ static void write_volume(const char *path, const int n[3], int type, const doubl
     nim->qoffset_x = m[0][3];
     nim->qoffset_y = m[1][3];
     nim->qoffset_z = m[2][3];
-    nim->dx = nim->pixdim[1] = h[0];
-    nim->dy = nim->pixdim[2] = h[1];
-    nim->dz = nim->pixdim[3] = h[2];
   } else {
     nim->qform_code = 0;
     nim->sform_code = 1;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 4; ++c) nim->sto_xyz.m[r][c] = m[r][c];
     nim->sto_xyz.m[3][3] = 1;
-    nim->dx = nim->pixdim[1] = h[0];
-    nim->dy = nim->pixdim[2] = h[1];
-    nim->dz = nim->pixdim[3] = h[2];
   }
+  nim->dx = nim->pixdim[1] = h[0];
+  nim->dy = nim->pixdim[2] = h[1];
+  nim->dz = nim->pixdim[3] = h[2];
   nim->xyz_units = NIFTI_UNITS_MICRON;
   CHECK(nifti_set_filenames(nim, path, 0, 1) == 0, "nifti_set_filenames %s", path);
   nifti_image_write(nim);
@@ -342,7 +339,7 @@ static double every_voxel(size_t i, size_t j, size_t k, void *ctx) {
 /** softpack run on a 3D scene with @p initial exits 2 naming
  *  initial.label_volume and @p what, and writes nothing. */
 static void refused(const char *name, const char *initial, const char *what) {
-  char scene[256], text[1024], args[1024], out[8192], dir[300];
+  char scene[256], args[1024], out[8192], dir[300];
   snprintf(scene, sizeof scene, "bad_%s.yaml", name);
   snprintf(dir, sizeof dir, "bad_%s_out", name);
   FILE *f = fopen(scene, "w");
@@ -358,7 +355,6 @@ static void refused(const char *name, const char *initial, const char *what) {
         "%s: status %d (expected 2), output dir %s, message: %s", name, status,
         stat(dir, &sb) == 0 ? "written" : "absent", out);
   printf("%s: %s", name, out);
-  (void)text;
 }
 
 static void bad_volumes(void) {
