@@ -210,8 +210,11 @@ static int volume_affine(const nifti_image *nim, const char *path, double m[3][4
 static int volume_labels(const nifti_image *nim, const char *path, sp_label_grid *g) {
   const size_t nv = g->n_samples;
   double *sorted = malloc(sizeof(double) * nv + 8);
-  g->label = malloc(sizeof(int) * nv + 4);
-  SP_CHECK(sorted && g->label, SP_ERR_MEMORY, "out of memory reading '%s'", path);
+  g->label = malloc(sizeof(int) * nv + 4); /* (freed by the caller on failure) */
+  if (!sorted || !g->label) {
+    free(sorted);
+    return sp_error_set(SP_ERR_MEMORY, "out of memory reading '%s'", path);
+  }
   size_t n_fg = 0;
   int rc = SP_OK;
   for (size_t i = 0; i < nv; ++i) {
