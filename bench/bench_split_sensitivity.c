@@ -66,7 +66,7 @@ int main(int argc, char **argv) {
   sp_layout *all = NULL, *one = NULL;
   int n = 0;
   if (!text || sp_scene_load_text(argv[1], text, strlen(text), 0, NULL, &scene) != SP_OK ||
-      sp_initial_cell_count(scene, &n) != SP_OK || n <= (a > b ? a : b) || a < 0 || b < 0 ||
+      sp_initial_cell_count(scene, NULL, &n) != SP_OK || n <= (a > b ? a : b) || a < 0 || b < 0 ||
       sp_mesh_from_scene(scene, &mesh) != SP_OK ||
       sp_layout_create_full(mesh->n_nodes, n, &all) != SP_OK ||
       sp_layout_create_full(mesh->n_nodes, 1, &one) != SP_OK) {

@@ -13,6 +13,10 @@
  *          the equilibrium profile 1 / (1 + e^(s/d)) of the signed
  *          distance s to it. Cells are numbered by colour (0xRRGGBB,
  *          ascending).
+ *        - initial.label_volume: the same in 3D from a NIfTI volume whose
+ *          nonzero integer voxels are labels, numbered by value (ascending),
+ *          placed by the file's sform (else qform, else voxel sizes), scaled
+ *          by initial.scale and moved by initial.offset_* (docs/3d.md).
  */
 #ifndef SP_INITIAL_H
 #define SP_INITIAL_H
@@ -26,9 +30,11 @@ extern "C" {
 #endif
 
 /** @brief The number of initial cells: the scene's, or the labels of
- *         initial.label_image, or the cells of initial.from (.vtu). Bad
- *         files are SP_ERR_INPUT naming the key. */
-int sp_initial_cell_count(const sp_scene *scene, int *n_cells);
+ *         initial.label_image or initial.label_volume, or the cells of
+ *         initial.from (.vtu). Bad files are SP_ERR_INPUT naming the key:
+ *         also too many labels for the initial layout, and (with @p mesh,
+ *         which may be NULL) a label volume's labelled voxel outside Omega. */
+int sp_initial_cell_count(const sp_scene *scene, const sp_mesh *mesh, int *n_cells);
 
 /** @brief The initial fields of those cells on @p layout (full, the mesh's
  *         own numbering), the seeded noise outside the cells as with disks

@@ -161,7 +161,7 @@ static int initial_run(sp_run *run, const sp_scene *scene, MPI_Comm comm,
    * checkpoint) has one placeholder cell until then. */
   const int placeholder = start && start->checkpoint && scene->n_cells == 0;
   *n = 1;
-  if (!placeholder) SP_CALL(sp_initial_cell_count(scene, n));
+  if (!placeholder) SP_CALL(sp_initial_cell_count(scene, run->mesh, n));
   SP_CALL(sp_layout_create_full(run->mesh->n_nodes, *n, &run->layout));
   SP_CALL(sp_fault_check(SP_FAULT_SETUP, run->rank));
   SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* creating the solver is collective */

@@ -594,6 +594,24 @@ static const sp_key sp_keys[] = {
               "label_image: x of the image's right edge (> x0)"),
     KEY_FLOAT(SP_SEC_INITIAL, "y1", initial.y1, 0.25, UNBOUNDED, UNBOUNDED, "L",
               "label_image: y of the image's top edge (> y0)"),
+    KEY_PATH(SP_SEC_INITIAL, "label_volume", initial.label_volume,
+             "3D meshes: start from a NIfTI label volume (.nii, .nii.gz): every "
+             "nonzero integer label is one cell, smoothed to the equilibrium "
+             "profile, placed by the file's sform (else qform, else voxel size) "
+             "(docs/3d.md)"),
+    KEY_FLOAT(SP_SEC_INITIAL, "scale", initial.scale, 1.0, ABOVE(0.0), UNBOUNDED, "L",
+              "label_volume: mesh length per unit of the file's coordinates (e.g. 0.01 "
+              "for a file in micrometres on a mesh in units of 100 um)"),
+    KEY_FLOAT(SP_SEC_INITIAL, "offset_x", initial.offset_x, 0.0, UNBOUNDED, UNBOUNDED, "L",
+              "label_volume: x where the file's origin lands (with centre: the labels' "
+              "centre)"),
+    KEY_FLOAT(SP_SEC_INITIAL, "offset_y", initial.offset_y, 0.0, UNBOUNDED, UNBOUNDED, "L",
+              "label_volume: y where the file's origin lands (see offset_x)"),
+    KEY_FLOAT(SP_SEC_INITIAL, "offset_z", initial.offset_z, 0.0, UNBOUNDED, UNBOUNDED, "L",
+              "label_volume: z where the file's origin lands (see offset_x)"),
+    KEY_BOOL(SP_SEC_INITIAL, "centre", initial.centre, 0, "-",
+             "label_volume: place the centre of the labelled voxels' bounding box, not "
+             "the file's origin, at (offset_x, offset_y, offset_z)"),
     /* cells: one mapping per initial cell */
     CELL_FLOAT_REQUIRED("x", x, UNBOUNDED, UNBOUNDED, "L",
                         "centre x; the cell's disk must lie inside Omega"),
@@ -1453,39 +1471,73 @@ static int apply_override(sp_scene *scene, const char *arg) {
 /* Checks across keys                                                       */
 /* ------------------------------------------------------------------------ */
 
+static int ends_with(const char *s, const char *tail) {
+  const size_t n = strlen(s), m = strlen(tail);
+  return n >= m && strcmp(s + n - m, tail) == 0;
+}
+
+/** A label volume: a NIfTI file (one file, maybe gzipped), on a 3D mesh. */
+static int check_label_volume(const sp_scene *scene, const char *file) {
+  const char *volume = scene->initial.label_volume;
+  SP_CHECK(ends_with(volume, ".nii") || ends_with(volume, ".nii.gz"), SP_ERR_INPUT,
+           "%s: initial.label_volume: expected a NIfTI file (.nii or .nii.gz), got '%s'",
+           file, volume);
+  SP_CHECK(sp_scene_dim(scene) == 3, SP_ERR_INPUT,
+           "%s: initial.label_volume: a label volume is 3D: expected a 3D mesh (mesh.type box "
+           "or ellipsoid), got mesh.type %s (a 2D scene takes a PNG, initial.label_image)",
+           file, sp_mesh_words[scene->mesh.type].str);
+  return SP_OK;
+}
+
+/** initial.from names a checkpoint or a .vtu. */
+static int check_from(const sp_scene_initial *in, const char *file) {
+  const size_t n = strlen(in->from);
+  SP_CHECK((n > 3 && strcmp(in->from + n - 3, ".h5") == 0) ||
+               (n > 4 && strcmp(in->from + n - 4, ".vtu") == 0),
+           SP_ERR_INPUT, "%s: initial.from: expected a softpack checkpoint (.h5) or .vtu, got '%s'",
+           file, in->from);
+  return SP_OK;
+}
+
+/** initial.label_image's box is not empty. */
+static int check_image_box(const sp_scene_initial *in, const char *file) {
+  SP_CHECK(in->x1 > in->x0, SP_ERR_INPUT,
+           "%s: initial.x1: expected a number > initial.x0 = %.15g, got %.15g", file,
+           in->x0, in->x1);
+  SP_CHECK(in->y1 > in->y0, SP_ERR_INPUT,
+           "%s: initial.y1: expected a number > initial.y0 = %.15g, got %.15g", file,
+           in->y0, in->y1);
+  return SP_OK;
+}
+
 /** Cells, or initial fields from a file: one of them. */
 static int check_initial(const sp_scene *scene, const char *file) {
   const sp_scene_initial *in = &scene->initial;
   const int from = in->from[0] != '\0', image = in->label_image[0] != '\0';
-  SP_CHECK(scene->n_cells > 0 || from || image, SP_ERR_INPUT,
+  const int volume = in->label_volume[0] != '\0';
+  /* the file that gives the cells, and its key */
+  const char *source = from ? in->from : image ? in->label_image : volume ? in->label_volume
+                                                                          : NULL;
+  const char *key = from ? "from" : image ? "label_image" : "label_volume";
+  SP_CHECK(scene->n_cells > 0 || source, SP_ERR_INPUT,
            "%s: cells: no cells given (the key is missing or its list is "
-           "empty); a scene needs at least one cell, or initial.from or "
-           "initial.label_image",
+           "empty); a scene needs at least one cell, or initial.from, "
+           "initial.label_image or initial.label_volume",
            file);
   SP_CHECK(!(from && image), SP_ERR_INPUT,
            "%s: initial.label_image: expected none with initial.from (give one "
            "source of initial fields), got '%s'", file, in->label_image);
-  SP_CHECK(scene->n_cells == 0 || !(from || image), SP_ERR_INPUT,
+  SP_CHECK(!(volume && (from || image)), SP_ERR_INPUT,
+           "%s: initial.label_volume: expected none with initial.%s (give one source of "
+           "initial fields), got '%s'", file, key, in->label_volume);
+  SP_CHECK(scene->n_cells == 0 || !source, SP_ERR_INPUT,
            "%s: cells: expected none with initial.%s (the file gives the cells), got %d",
-           file, from ? "from" : "label_image", scene->n_cells);
-  if (from) {
-    const size_t n = strlen(in->from);
-    SP_CHECK((n > 3 && strcmp(in->from + n - 3, ".h5") == 0) ||
-                 (n > 4 && strcmp(in->from + n - 4, ".vtu") == 0),
-             SP_ERR_INPUT, "%s: initial.from: expected a softpack checkpoint (.h5) or .vtu, got '%s'",
-             file, in->from);
-  }
-  const char *source = from ? in->from : image ? in->label_image : NULL;
+           file, key, scene->n_cells);
+  if (volume) SP_CALL(check_label_volume(scene, file));
+  if (from) SP_CALL(check_from(in, file));
   SP_CHECK(!source || access(source, R_OK) == 0, SP_ERR_INPUT,
-           "%s: initial.%s: cannot read '%s': %s", file, from ? "from" : "label_image", source,
-           strerror(errno));
-  SP_CHECK(!image || in->x1 > in->x0, SP_ERR_INPUT,
-           "%s: initial.x1: expected a number > initial.x0 = %.15g, got %.15g", file,
-           in->x0, in->x1);
-  SP_CHECK(!image || in->y1 > in->y0, SP_ERR_INPUT,
-           "%s: initial.y1: expected a number > initial.y0 = %.15g, got %.15g", file,
-           in->y0, in->y1);
-  return SP_OK;
+           "%s: initial.%s: cannot read '%s': %s", file, key, source, strerror(errno));
+  return image ? check_image_box(in, file) : SP_OK;
 }
 
 /** mesh.semi_z given on an ellipsoid (and only there), its refinements at
@@ -1569,8 +1621,9 @@ static int check_3d(const sp_scene *scene, const char *file) {
            "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
            ": expected none, got '%s'", file, scene->initial.from);
   SP_CHECK(scene->initial.label_image[0] == '\0', SP_ERR_INPUT,
-           "%s: initial.label_image: label images (and 3D label volumes) are " SP_NOT_YET_3D
-           ": expected none, got '%s'", file, scene->initial.label_image);
+           "%s: initial.label_image: a PNG label image is 2D: expected none on a 3D mesh "
+           "(a 3D scene takes a NIfTI label volume, initial.label_volume), got '%s'", file,
+           scene->initial.label_image);
   return SP_OK;
 }
 
@@ -1878,7 +1931,8 @@ static int check_lineage(const sp_scene *scene, const char *file) {
 /** The initial layout (every cell on every node: a run starts with it, also
  *  before cutting local supports) must be numberable by ints and Epetra's
  *  32-bit global ids; checked here, before anything that large is allocated. */
-static int check_sizes(const sp_scene *scene, const char *file) {
+static int check_sizes(const sp_scene *scene, int n_cells, const char *cells_key,
+                       const char *file) {
   const sp_scene_mesh *m = &scene->mesh;
   const int rectangle = m->type == SP_MESH_RECTANGLE, box = m->type == SP_MESH_BOX;
   const int ellipsoid = m->type == SP_MESH_ELLIPSOID;
@@ -1886,7 +1940,7 @@ static int check_sizes(const sp_scene *scene, const char *file) {
                           : box     ? sp_mesh_box_nodes(m->nx, m->ny, m->nz)
                           : ellipsoid ? sp_mesh_ellipsoid_nodes(m->refinements, m->buffer_layers)
                                       : sp_mesh_ellipse_nodes(m->refinements, m->buffer_layers);
-  const long long pairs = nodes * scene->n_cells;
+  const long long pairs = nodes * n_cells;
   char mesh_keys[SP_TEXT];
   if (rectangle)
     snprintf(mesh_keys, sizeof mesh_keys, "mesh.nx, mesh.ny (%d x %d elements)", m->nx, m->ny);
@@ -1898,28 +1952,33 @@ static int check_sizes(const sp_scene *scene, const char *file) {
              "mesh.refinements, mesh.buffer_layers (%d refinements, %d buffer layers)",
              m->refinements, m->buffer_layers);
   SP_CHECK(pairs <= SP_LAYOUT_MAX_PAIRS, SP_ERR_INPUT,
-           "%s: %s and cells (%d cells): too large: %lld nodes x %d cells = %lld (cell, node) "
+           "%s: %s and %s (%d cells): too large: %lld nodes x %d cells = %lld (cell, node) "
            "pairs in the initial layout, 2 x %lld unknowns; at most %d pairs fit the "
            "solver's 32-bit indices (Epetra's global ids): use fewer elements or cells",
-           file, mesh_keys, scene->n_cells, nodes, scene->n_cells, pairs, pairs,
+           file, mesh_keys, cells_key, n_cells, nodes, n_cells, pairs, pairs,
            SP_LAYOUT_MAX_PAIRS);
   /* A run that keeps every cell on every node hands that layout to the
    * solver: its matrix's nonzeros must fit too (sp_nonzeros_bound). Local
    * supports are checked when each layout is handed over (the run's). */
   const int full = scene->layout.support == SP_SUPPORT_FULL ||
                    (scene->layout.support == SP_SUPPORT_AUTO &&
-                    scene->n_cells + scene->n_lineage <= 4 &&
+                    n_cells + scene->n_lineage <= 4 &&
                     scene->division.criterion == SP_DIVIDE_NONE);
   const int dim = sp_scene_dim(scene);
-  const long long nonzeros = sp_nonzeros_bound(dim, nodes, scene->n_cells);
+  const long long nonzeros = sp_nonzeros_bound(dim, nodes, n_cells);
   SP_CHECK(!full || nonzeros <= SP_LAYOUT_MAX_NONZEROS, SP_ERR_INPUT,
-           "%s: %s, cells (%d cells) and layout.support (every cell on every node): too "
+           "%s: %s, %s (%d cells) and layout.support (every cell on every node): too "
            "large: the Jacobian would hold up to %lld nonzeros (%lld nodes x %d x %d x %d), "
            "more than the %lld the solvers' 32-bit offsets count: use fewer elements or "
            "cells, or layout.support: local",
-           file, mesh_keys, scene->n_cells, nonzeros, nodes, dim == 3 ? 27 : 9, scene->n_cells,
-           scene->n_cells + 3, SP_LAYOUT_MAX_NONZEROS);
+           file, mesh_keys, cells_key, n_cells, nonzeros, nodes, dim == 3 ? 27 : 9, n_cells,
+           n_cells + 3, SP_LAYOUT_MAX_NONZEROS);
   return SP_OK;
+}
+
+int sp_scene_check_cell_count(const sp_scene *scene, int n_cells, const char *cells_key,
+                              const char *where) {
+  return check_sizes(scene, n_cells, cells_key, where);
 }
 
 /* ------------------------------------------------------------------------ */
@@ -1943,7 +2002,7 @@ static int fill_scene(sp_scene *scene, const char *path, const char *text,
   SP_CALL(check_initial(scene, where));
   SP_CALL(check_cells(scene, where));
   SP_CALL(check_lineage(scene, where));
-  SP_CALL(check_sizes(scene, where));
+  SP_CALL(check_sizes(scene, scene->n_cells, "cells", where));
   return SP_OK;
 }
 

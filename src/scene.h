@@ -246,6 +246,10 @@ typedef struct {
   char from[SP_SCENE_PATH_MAX];        /**< a softpack checkpoint (.h5) or .vtu ("": none) */
   char label_image[SP_SCENE_PATH_MAX]; /**< a PNG of labels, one colour a cell ("": none) */
   double x0, y0, x1, y1;               /**< label_image: the box of Omega it covers */
+  char label_volume[SP_SCENE_PATH_MAX]; /**< a NIfTI volume of labels, 3D ("": none) */
+  double scale;                        /**< label_volume: L per unit of its coordinates */
+  double offset_x, offset_y, offset_z; /**< label_volume: where its origin (or centre) lands */
+  int centre;                          /**< label_volume: centre its labels at the offset */
 } sp_scene_initial;
 
 typedef struct sp_scene {
@@ -260,7 +264,7 @@ typedef struct sp_scene {
   sp_scene_shape shape;
   sp_scene_layout layout;
   sp_scene_initial initial;
-  int n_cells;         /**< 0 when initial.from or initial.label_image gives the cells */
+  int n_cells;         /**< 0 when initial.from, label_image or label_volume gives the cells */
   sp_scene_cell *cells;
   int n_lineage;       /**< entries of the lineage table (0: none) */
   sp_scene_lineage *lineage;
@@ -302,6 +306,15 @@ int sp_scene_read_file(const char *path, char **text, size_t *len);
 /** @brief The dimension of the scene's mesh: 3 for mesh.type box and
  *         ellipsoid, else 2. */
 int sp_scene_dim(const sp_scene *scene);
+
+/** @brief SP_OK if the initial layout of @p n_cells cells (every cell on
+ *         every node of the scene's mesh) fits the solver's 32-bit indices,
+ *         else SP_ERR_INPUT beginning with @p where and naming the mesh keys
+ *         and @p cells_key (what gave the cells: "cells", or a file's key
+ *         such as "initial.label_volume"); the scene load checks its own
+ *         cells so. */
+int sp_scene_check_cell_count(const sp_scene *scene, int n_cells, const char *cells_key,
+                              const char *where);
 
 /** @brief Interface width d = sqrt(kappa / (2 alpha)) of the scene's model. */
 double sp_scene_interface_width(const sp_scene *scene);

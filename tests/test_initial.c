@@ -127,7 +127,7 @@ static void label_image(void) {
   fclose(junk);
   const char *not_png = "mesh: {type: rectangle}\ninitial: {label_image: not_a.png}\n";
   CHECK_OK(sp_scene_load_text("not_png", not_png, strlen(not_png), 0, NULL, &bad));
-  CHECK(sp_initial_cell_count(bad, &n) == SP_ERR_INPUT &&
+  CHECK(sp_initial_cell_count(bad, NULL, &n) == SP_ERR_INPUT &&
             strstr(sp_error_message(), "initial.label_image"), "not a PNG: %s",
         sp_error_message());
   sp_scene_destroy(&bad);

@@ -111,7 +111,8 @@ int main(void) {
         scene->output.checkpoint_every);
   sp_scene_destroy(&scene);
   refused(NULL, "initial: {from: run.h5}\n", "initial.from", "not yet in 3D");
-  refused(NULL, "initial: {label_image: cells.png}\n", "initial.label_image", "not yet in 3D");
+  refused(NULL, "initial: {label_image: cells.png}\n", "initial.label_image",
+          "initial.label_volume");
 
   /* the ellipsoid (mesh.type ellipsoid): semi_z required and > 0, only
    * there; its refinements at most 7; spheres inside it */

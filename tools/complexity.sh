@@ -9,7 +9,7 @@
 #
 # Prints the TOP (default 15) most complex functions and exits 1 if a
 # limit is exceeded. Needs clang-tidy and the build's headers (Debian:
-# clang-tidy, libopenmpi-dev, libhdf5-openmpi-dev, libcairo2-dev).
+# clang-tidy, libopenmpi-dev, libhdf5-openmpi-dev, libcairo2-dev, libnifti2-dev).
 set -uo pipefail
 src=${1:-$(dirname "$0")/..}
 top=${2:-15}
@@ -17,7 +17,7 @@ RUN_LIMIT=40 SRC_LIMIT=60
 RUN_MODULES="stepper step events monitor run_setup resize run_options registry"
 flags=(-std=c11 -D_POSIX_C_SOURCE=200809L -I"$src/src" -I"$src/c_api"
        $(mpicc --showme:compile 2> /dev/null)
-       $(pkg-config --cflags hdf5-openmpi cairo 2> /dev/null))
+       $(pkg-config --cflags hdf5-openmpi cairo 2> /dev/null) -I/usr/include/nifti)
 # sp_revision.h is generated at build time: a stand-in
 gen=$(mktemp -d)
 trap 'rm -rf "$gen"' EXIT

@@ -19,7 +19,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(cmake make g++ pkg-config
   trilinos-all-dev trilinos-dev libsuperlu-dev libsuperlu-dist-dev libmumps-dev libsuitesparse-dev
   libopenmpi-dev openmpi-bin libptscotch-dev libscotch-dev libopenblas-dev
-  libcyaml-dev libcairo2-dev libhdf5-openmpi-dev)
+  libcyaml-dev libcairo2-dev libhdf5-openmpi-dev libnifti2-dev)
 
 # install_missing [EXTRA_PACKAGE...]: PACKAGES and the extras a command needs
 install_missing() {
