@@ -150,7 +150,9 @@ typedef struct {
 
 /**
  * Shape-penalty data of one cell (MODEL.md, shape penalty): the term adds
- * -sum_i coef_i * (v_i . Ibar(X) v_i) to mu_k, Ibar about (xc, yc).
+ * -sum_i coef_i * (v_i . Ibar(X) v_i) to mu_k, Ibar about the centre (xc,
+ * yc[, zc]), i over the mesh's dim principal moments (2 in 2D, 3 in 3D;
+ * Ibar = |Xb|^2 Id - Xb Xb^T, src/shape.h). Entries beyond dim are unused.
  *
  * Explicit (sp_step_data.shape_implicit = 0): coef as given, from c^n.
  * Linearised implicit (shape_implicit = 1): with the centre, eigenvectors
@@ -158,14 +160,15 @@ typedef struct {
  * I_j = I_j^n + dI_j, dI_j = int_mask Ihat_j (c - c^n) (exact to first
  * order: the centre's shift does not move central moments at first order),
  * and the term uses coef_i - sum_j gain[i][j] dI_j. Its Jacobian adds, per
- * cell, u_i gain[i][j] u_j^T (u_i = int_mask Ihat_i N: rank two per cell),
+ * cell, u_i gain[i][j] u_j^T (u_i = int_mask Ihat_i N: rank dim per cell),
  * applied by Sherman-Morrison-Woodbury on the sparse factorisation.
  */
 typedef struct {
   double xc, yc;
-  double v[2][2];  /**< unit eigenvectors v_1 (larger moment), v_2 */
-  double coef[2];  /**< 2 delta^i (I^i,ref - I^i) */
-  double gain[2][2]; /**< -d coef_i / d I_j (implicit only; 0: none) */
+  double zc;       /**< 3D: the centre's z (0 in 2D) */
+  double v[3][3];  /**< unit eigenvectors v_1 (largest moment), v_2 (, v_3) */
+  double coef[3];  /**< 2 delta^i (I^i,ref - I^i) (round cells: src/shape.h) */
+  double gain[3][3]; /**< -d coef_i / d I_j (implicit only; 0: none) */
   double threshold; /**< the term acts only where c^n >= threshold (at the
                          quadrature point), as the observables count c only
                          where c >= their weight threshold */

@@ -416,7 +416,8 @@ double Assembly::compare_jacobians(const sp_step_data &d, const double *state, i
 }
 
 void Assembly::shape_weights(const sp_step_data &d, std::vector<double> &u) const {
-  std::vector<double> mine(2 * (size_t)n_pairs_, 0.0);
+  // dim_ weights per pair: one per principal moment
+  std::vector<double> mine((size_t)dim_ * n_pairs_, 0.0);
   agree_local(comm_, [&] {
     for (int e : my_elems_) {
       const ElementGeometry geo = geometry(e);
@@ -430,11 +431,12 @@ void Assembly::shape_weights(const sp_step_data &d, std::vector<double> &u) cons
           double c_old = 0.0;
           for (int a = 0; a < nen_; ++a) c_old += N[a] * d.state_old[2 * pairs[a]];
           if (c_old < sc.threshold) continue;  // the mask of element_residual
-          // (the shape term is 2D only: scene.c refuses it on a 3D mesh)
-          const double xb = geo.x(q)[0] - sc.xc, yb = geo.x(q)[1] - sc.yc;
-          for (int i = 0; i < 2; ++i) {
-            const double ihat = shape_ihat(sc.v[i], xb, yb);
-            for (int a = 0; a < nen_; ++a) mine[2 * pairs[a] + i] += geo.w(q) * N[a] * ihat;
+          const double *x = geo.x(q);
+          const double xb[3] = {x[0] - sc.xc, x[1] - sc.yc, dim_ == 3 ? x[2] - sc.zc : 0.0};
+          for (int i = 0; i < dim_; ++i) {
+            const double ihat = shape_ihat(sc.v[i], xb, dim_);
+            for (int a = 0; a < nen_; ++a)
+              mine[(size_t)dim_ * pairs[a] + i] += geo.w(q) * N[a] * ihat;
           }
         }
       }

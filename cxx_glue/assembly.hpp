@@ -31,6 +31,7 @@ class Assembly {
   const Epetra_CrsGraph &graph() const { return *graph_; }
   int n_dofs() const { return 2 * n_pairs_; }
   int n_cells() const { return n_cells_; }
+  int dim() const { return dim_; }  // the mesh's: 2 or 3
 
   // Residual F (owned rows of map()) at the full (replicated) state.
   void residual(const sp_step_data &data, const double *state, Epetra_Vector &F) const;
@@ -46,10 +47,11 @@ class Assembly {
   double compare_jacobians(const sp_step_data &data, const double *state, int kind_a,
                            int kind_b) const;
   // The shape term's weights of every pair p (replicated, reduced over the
-  // ranks): u[2p + i] = int N_p Ihat_i over the quadrature points where
-  // c^n >= the cell's threshold, Ihat_i about the cell's frozen centre and
-  // eigenvector i (data.shape). The term's rows in mu are -coef_i u_i, and
-  // int_mask Ihat_i c = sum_p u[2p + i] c_p for any c of the layout.
+  // ranks): u[dim p + i] = int N_p Ihat_i, i < dim() (one per principal
+  // moment), over the quadrature points where c^n >= the cell's threshold,
+  // Ihat_i about the cell's frozen centre and eigenvector i (data.shape).
+  // The term's rows in mu are -coef_i u_i, and int_mask Ihat_i c =
+  // sum_p u[dim p + i] c_p for any c of the layout.
   void shape_weights(const sp_step_data &data, std::vector<double> &u) const;
   int pair_cell(int p) const { return pair_cell_[p]; }
   // Gathers and computes every element matrix of this rank without adding

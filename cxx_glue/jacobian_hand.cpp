@@ -84,7 +84,7 @@ void hand_element_q1(const ElementGeometry &geo, int nc, const double *u,
         d2 += buffer_d2(m);
       }
       if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
-        local += shape_mu(*in.shape[j], g.x[q][0], g.x[q][1]);  // 2D only (scene.c)
+        local += shape_mu(*in.shape[j], g.x[q], dim);
       dq[q * nc + j] = d2;
       const double rate = c - c_old - in.dt * s;
       for (int a = 0; a < nen; ++a) {

@@ -2,7 +2,7 @@
 // DirectSolver for A by Sherman-Morrison-Woodbury (the idea of PETSc's
 // MATLRC): the backend never sees the dense coupling, and the Newton code
 // never sees Woodbury. The implicit shape term (shape_implicit.hpp) is the
-// one user: rank two per cell, dense over the cell.
+// one user: rank dim (two in 2D, three in 3D) per cell, dense over the cell.
 #ifndef SP_LINEAR_LOW_RANK_HPP
 #define SP_LINEAR_LOW_RANK_HPP
 

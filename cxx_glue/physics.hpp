@@ -44,18 +44,28 @@ template <class S> S buffer_d1(const sp_model_params &m, const S &c) {
 }
 inline double buffer_d2(const sp_model_params &m) { return 2.0 * m.lambda_b; }
 
-// Ihat = v . Ibar(Xb) v with Ibar(Xb) = [[Xb2^2, -Xb1 Xb2], [-Xb1 Xb2, Xb1^2]]
-// (MODEL.md): the derivative of the principal moment of eigenvector v in c.
-inline double shape_ihat(const double v[2], double xb, double yb) {
-  return v[0] * v[0] * yb * yb - 2.0 * v[0] * v[1] * xb * yb + v[1] * v[1] * xb * xb;
+// Ihat = v . Ibar(Xb) v with Ibar(Xb) = |Xb|^2 Id - Xb Xb^T (MODEL.md; in 2D
+// [[Xb2^2, -Xb1 Xb2], [-Xb1 Xb2, Xb1^2]]): the derivative of the principal
+// moment of eigenvector v in c. In 3D written as |v x Xb|^2 (the same for a
+// unit v: no cancellation where Xb is along v, never negative); the 2D
+// expression is the one the 2D outputs were made with.
+inline double shape_ihat(const double v[3], const double *xb, int dim) {
+  if (dim == 2)
+    return v[0] * v[0] * xb[1] * xb[1] - 2.0 * v[0] * v[1] * xb[0] * xb[1] +
+           v[1] * v[1] * xb[0] * xb[0];
+  const double a = v[1] * xb[2] - v[2] * xb[1], b = v[2] * xb[0] - v[0] * xb[2],
+               c = v[0] * xb[1] - v[1] * xb[0];
+  return a * a + b * b + c * c;
 }
 
-// The shape term's value in mu_k at X: -sum_i coef_i Ihat_i(X), with the
+// The shape term's value in mu_k at the point x (dim coordinates):
+// -sum_i coef_i Ihat_i(x), i over the dim principal moments, with the
 // coefficients of the step (explicit, or updated by the Newton iterate's
 // moments when implicit: newton.cpp).
-inline double shape_mu(const sp_shape_coef &s, double x, double y) {
+inline double shape_mu(const sp_shape_coef &s, const double *x, int dim) {
+  const double xb[3] = {x[0] - s.xc, x[1] - s.yc, dim == 3 ? x[2] - s.zc : 0.0};
   double value = 0.0;
-  for (int i = 0; i < 2; ++i) value -= s.coef[i] * shape_ihat(s.v[i], x - s.xc, y - s.yc);
+  for (int i = 0; i < dim; ++i) value -= s.coef[i] * shape_ihat(s.v[i], xb, dim);
   return value;
 }
 

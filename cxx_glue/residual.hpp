@@ -128,7 +128,7 @@ void element_residual_q1(const ElementGeometry &geo, int n_cells, const S *u,
       S local = well_d1(m, c[j]) + repulsion_d1(m, c[j], sum_sq);
       if (g.buffer) local += buffer_d1(m, c[j]);
       if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
-        local += shape_mu(*in.shape[j], g.x[q][0], g.x[q][1]);  // 2D only (scene.c)
+        local += shape_mu(*in.shape[j], g.x[q], dim);
       const S rate = c[j] - c_old - in.dt * s;
       const S *gm = &gmu[dim * j], *gcj = &gc[dim * j];
       for (int a = 0; a < nen; ++a) {

@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <hdf5.h>
 #include <hdf5_hl.h>
+#include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -180,10 +181,29 @@ enum { H_STEP, H_N_MAX, H_MPI_SIZE, H_N_CELLS, H_HIST_N, H_N_ENERGY, H_N_DIVISIO
        HEADER_INTS };
 enum { H_T, H_DT0, H_DT1, HEADER_DOUBLES };
 
-/** sp_shape_coef as doubles in /carry/shape. */
-enum { SHAPE_DOUBLES = sizeof(sp_shape_coef) / sizeof(double) };
-_Static_assert(sizeof(sp_shape_coef) == SHAPE_DOUBLES * sizeof(double),
-               "sp_shape_coef holds doubles only");
+/** sp_shape_coef as doubles in /carry/shape, the members a mesh of
+ *  dimension @p dim uses in this order: xc, yc (, zc), v[i][d], coef[i],
+ *  gain[i][j] (i, j, d < dim), threshold; 13 in 2D (the order of the 2D
+ *  struct the first files were written from), 25 in 3D. With @p unpack
+ *  the doubles are read back into @p s. */
+static size_t shape_doubles(int dim, sp_shape_coef *s, double *d, int unpack) {
+  double *m[32];
+  size_t n = 0;
+  m[n++] = &s->xc;
+  m[n++] = &s->yc;
+  if (dim == 3) m[n++] = &s->zc;
+  for (int i = 0; i < dim; ++i)
+    for (int e = 0; e < dim; ++e) m[n++] = &s->v[i][e];
+  for (int i = 0; i < dim; ++i) m[n++] = &s->coef[i];
+  for (int i = 0; i < dim; ++i)
+    for (int j = 0; j < dim; ++j) m[n++] = &s->gain[i][j];
+  m[n++] = &s->threshold;
+  for (size_t i = 0; d && i < n; ++i) {
+    if (unpack) *m[i] = d[i];
+    else d[i] = *m[i];
+  }
+  return n;
+}
 
 /** /carry: where the factorisation the next step begins on was filled. */
 static int put_carry(hid_t f, const sp_run *run) {
@@ -200,9 +220,18 @@ static int put_carry(hid_t f, const sp_run *run) {
   if (!carry) return bad;
   bad |= put_array(f, "/carry/dt", H5T_NATIVE_DOUBLE, &dt, 1);
   bad |= put_array(f, "/carry/x", H5T_NATIVE_DOUBLE, x, 2 * (size_t)run->layout->n_pairs);
-  if (n_shape > 0)
-    bad |= put_array(f, "/carry/shape", H5T_NATIVE_DOUBLE, shape,
-                     SHAPE_DOUBLES * (size_t)n_shape);
+  if (n_shape > 0) {
+    const int dim = run->mesh->dim;
+    const size_t per = shape_doubles(dim, &(sp_shape_coef){0}, NULL, 0);
+    double *packed = malloc(sizeof(double) * per * (size_t)n_shape);
+    if (!packed) return 1;
+    for (int k = 0; k < n_shape; ++k) {
+      sp_shape_coef s = shape[k];
+      shape_doubles(dim, &s, packed + per * k, 0);
+    }
+    bad |= put_array(f, "/carry/shape", H5T_NATIVE_DOUBLE, packed, per * (size_t)n_shape);
+    free(packed);
+  }
   return bad;
 }
 
@@ -272,6 +301,10 @@ static int write_state(hid_t f, const sp_run *run) {
       col[2 * k + 1] = run->cells.birth[k].Iref[1];
     }
     bad |= put_array(f, "/cells/Iref", H5T_NATIVE_DOUBLE, col, 2 * nc);
+    if (run->mesh->dim == 3) { /* the third moment's, apart: 2D files as before */
+      for (size_t k = 0; k < nc; ++k) col[k] = run->cells.birth[k].Iref[2];
+      bad |= put_array(f, "/cells/Iref3", H5T_NATIVE_DOUBLE, col, nc);
+    }
     for (size_t k = 0; k < nc; ++k) icol[k] = run->cells.birth[k].generation;
     bad |= put_array(f, "/cells/generation", H5T_NATIVE_INT, icol, nc);
   }
@@ -710,8 +743,9 @@ static int read_history(const sp_checkpoint ck, sp_history *h, size_t n_values) 
   return SP_OK;
 }
 
-/** The registry of @p nc cells (sized and zeroed by the caller). */
-static int read_registry(const sp_checkpoint ck, sp_registry *cells, int nc) {
+/** The registry of @p nc cells (sized and zeroed by the caller) on a mesh
+ *  of dimension @p dim. */
+static int read_registry(const sp_checkpoint ck, sp_registry *cells, int nc, int dim) {
   double *col = malloc(sizeof(double) * (2 * (size_t)nc + 1));
   int *icol = malloc(sizeof(int) * ((size_t)nc + 1));
   int rc = col && icol ? SP_OK : sp_error_set(SP_ERR_MEMORY, "out of memory");
@@ -723,6 +757,13 @@ static int read_registry(const sp_checkpoint ck, sp_registry *cells, int nc) {
   for (int k = 0; rc == SP_OK && k < nc; ++k) {
     cells->birth[k].Iref[0] = col[2 * k];
     cells->birth[k].Iref[1] = col[2 * k + 1];
+    /* 2D: no third moment; a 3D file without /cells/Iref3 was written
+     * before the 3D shape term (its scene has none): unknown */
+    cells->birth[k].Iref[2] = dim == 3 ? NAN : 0.0;
+  }
+  if (rc == SP_OK && dim == 3 && H5LTpath_valid(ck->file, "/cells/Iref3", 1) > 0) {
+    rc = get_array(ck, "/cells/Iref3", H5T_NATIVE_DOUBLE, col, nc);
+    for (int k = 0; rc == SP_OK && k < nc; ++k) cells->birth[k].Iref[2] = col[k];
   }
   if (rc == SP_OK) rc = get_array(ck, "/cells/generation", H5T_NATIVE_INT, icol, nc);
   for (int k = 0; rc == SP_OK && k < nc; ++k) cells->birth[k].generation = icol[k];
@@ -766,7 +807,7 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
   const size_t n_values = 2 * (size_t)layout->n_pairs;
   if (as_initial) return SP_OK; /* the caller makes the registry of a new run */
   SP_CALL(read_history(ck, &run->hist, n_values));
-  SP_CALL(read_registry(ck, &run->cells, nc));
+  SP_CALL(read_registry(ck, &run->cells, nc, run->mesh->dim));
   /* the controller, the counters, step and time */
   SP_CALL(get_members(ck->file, ck->path, "/controller", &run->dtc, controller_members,
                       N_OF(controller_members)));
@@ -796,17 +837,22 @@ int sp_checkpoint_restore_carry(const sp_checkpoint ck, sp_run *run) {
                        (n_shape == 0 || n_shape == run->layout->n_cells)))
     rc = sp_error_set(SP_ERR_INPUT, "checkpoint '%s': /carry damaged", ck->path);
   const size_t n_values = 2 * (size_t)run->layout->n_pairs;
-  double dt = 0, *x = NULL;
+  const int dim = run->mesh->dim;
+  const size_t per = shape_doubles(dim, &(sp_shape_coef){0}, NULL, 0);
+  double dt = 0, *x = NULL, *packed = NULL;
   sp_shape_coef *shape = NULL;
   if (rc == SP_OK && carry) {
     x = malloc(sizeof(double) * n_values + 1);
-    shape = n_shape ? malloc(sizeof *shape * (size_t)n_shape) : NULL;
-    if (!x || (n_shape && !shape)) rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
+    shape = n_shape ? calloc((size_t)n_shape, sizeof *shape) : NULL;
+    packed = n_shape ? malloc(sizeof(double) * per * (size_t)n_shape) : NULL;
+    if (!x || (n_shape && (!shape || !packed)))
+      rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
     if (rc == SP_OK) rc = get_array(ck, "/carry/dt", H5T_NATIVE_DOUBLE, &dt, 1);
     if (rc == SP_OK) rc = get_array(ck, "/carry/x", H5T_NATIVE_DOUBLE, x, n_values);
     if (rc == SP_OK && n_shape)
-      rc = get_array(ck, "/carry/shape", H5T_NATIVE_DOUBLE, shape,
-                     SHAPE_DOUBLES * (size_t)n_shape);
+      rc = get_array(ck, "/carry/shape", H5T_NATIVE_DOUBLE, packed, per * (size_t)n_shape);
+    for (int k = 0; rc == SP_OK && k < n_shape; ++k)
+      shape_doubles(dim, &shape[k], packed + per * k, 1);
     if (rc == SP_OK && !(dt > 0))
       rc = sp_error_set(SP_ERR_INPUT, "checkpoint '%s': /carry/dt damaged", ck->path);
   }
@@ -821,5 +867,6 @@ int sp_checkpoint_restore_carry(const sp_checkpoint ck, sp_run *run) {
   }
   free(x);
   free(shape);
+  free(packed);
   return rc;
 }

@@ -16,7 +16,9 @@
  *   /state            c and mu of every pair (2 n_pairs)
  *   /history          past0, past1 (2 n_pairs each, as many as valid);
  *                     attributes n, dt0, dt1
- *   /cells            birth_time, birth_mass, Iref (2 per cell), generation,
+ *   /cells            birth_time, birth_mass, Iref (2 per cell: I^1,ref,
+ *                     I^2,ref), 3D: Iref3 (I^3,ref per cell; absent in 3D
+ *                     files written before the 3D shape term), generation,
  *                     source_on, division_skipped, divided_now
  *   /controller       the time-step controller's state (dt_control.h), one
  *                     attribute per member; its parameters come from the scene
@@ -24,7 +26,8 @@
  *   /output           energy_t, energy_total (energy.png), division_t,
  *                     field_step, field_t, field_pvtu (fields.pvd)
  *   /carry            header (carry, n_shape, shape_implicit); with carry = 1
- *                     dt, x (2 n_pairs), shape (13 per cell, or none): where
+ *                     dt, x (2 n_pairs), shape (13 per cell in 2D, 25 in
+ *                     3D: checkpoint.c, shape_doubles; or none): where
  *                     the factorisation the next step begins on
  *                     (solver.jacobian_carry) was filled, so a continued
  *                     run rebuilds it (absent in older files: no carry)

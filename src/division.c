@@ -35,7 +35,7 @@ int sp_division_params_check(const sp_division_params *params) {
 
 sp_cell_birth sp_cell_birth_make(double t, const sp_cell_obs *obs, int generation) {
   sp_cell_birth birth = {.birth_time = t, .birth_mass = obs->mass,
-                         .Iref = {obs->I1, obs->I2}, .generation = generation};
+                         .Iref = {obs->I1, obs->I2, obs->I3}, .generation = generation};
   return birth;
 }
 

@@ -48,8 +48,9 @@ extern "C" {
 typedef struct {
   double birth_time; /**< t at which the cell was born (0 for initial cells) */
   double birth_mass; /**< m_k^0: its mass right after birth */
-  double Iref[2];    /**< reference principal moments I^1,ref >= I^2,ref:
-                          the cell's moments right after birth */
+  double Iref[3];    /**< reference principal moments I^1,ref >= I^2,ref
+                          (>= I^3,ref in 3D; Iref[2] = 0 in 2D): the
+                          cell's moments right after birth */
   int generation;    /**< 0 for initial cells; both daughters of a division
                           get the parent's generation + 1 */
 } sp_cell_birth;

@@ -54,8 +54,8 @@ static int record_energy(sp_run *run, double dt, int its, const sp_step_costs *c
   if (known) parts = *known;
   else SP_CALL(sp_run_energy(run, &parts));
   const int n_cells = run->layout->n_cells;
-  const double shape = sp_shape_energy(n_cells, run->cells.obs, run->cells.birth,
-                                       run->opt.terms.shape_delta1, run->opt.terms.shape_delta2);
+  const double shape =
+      sp_shape_energy(n_cells, run->cells.obs, run->cells.birth, run->opt.terms.shape_delta);
   const double total = sp_energy_fields(&parts) + shape;
   if (mon->n_energy == mon->cap_energy) {
     const int cap = mon->cap_energy ? 2 * mon->cap_energy : 1024;

@@ -77,8 +77,8 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
                                     .interface_width = sp_scene_interface_width(scene)};
   opt->terms = (sp_run_terms){.source_rate = scene->source.rate,
                               .source_off_ratio = scene->source.off_ratio,
-                              .shape_delta1 = scene->shape.delta1,
-                              .shape_delta2 = scene->shape.delta2,
+                              .shape_delta = {scene->shape.delta1, scene->shape.delta2,
+                                              scene->shape.delta3},
                               .shape_implicit = scene->shape.scheme == SP_SHAPE_IMPLICIT,
                               .shrink_always = scene->layout.shrink == SP_SHRINK_ALWAYS};
   opt->output = (sp_run_output){.every = out->every, .interval = out->interval,

@@ -45,7 +45,7 @@ typedef struct {
 typedef struct {
   double source_rate;      /**< source.rate (0: no source) */
   double source_off_ratio; /**< source.off_ratio */
-  double shape_delta1, shape_delta2; /**< shape.delta1/2 */
+  double shape_delta[3];   /**< shape.delta1/2/3 (delta3 0 in 2D) */
   int shape_implicit;      /**< shape.scheme: implicit */
   int shrink_always;       /**< layout.shrink: always */
 } sp_run_terms;

@@ -273,8 +273,8 @@ static const sp_key sp_keys[] = {
     /* mesh */
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
              "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
-             "or an ellipsoid of hexahedra (3D; not yet with the shape "
-             "term or initial files: issue 29)"),
+             "or an ellipsoid of hexahedra (3D; not yet with initial fields from "
+             "initial.from: issue 29)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
               "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
@@ -563,20 +563,24 @@ static const sp_key sp_keys[] = {
              "equations at the free edge's chemical potential (relax: far "
              "fewer steps with narrow margins, docs/local-support.md)"),
     /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
-     * in E L^2, so delta is in E / L^6 */
+     * in E L^2, so delta is in E / L^6 (3D: L^5, E L^3, E / L^7) */
     KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),
               UNBOUNDED, "E/L^6",
-              "shape penalty modulus on the larger principal moment I^1 "
+              "shape penalty modulus on the largest principal moment I^1 "
               "(0: none; the paper's single-cell study: -> 0)"),
     KEY_FLOAT(SP_SEC_SHAPE, "delta2", shape.delta2, 0.0, AT_LEAST(0.0),
               UNBOUNDED, "E/L^6",
-              "shape penalty modulus on the smaller principal moment I^2 "
-              "(0: none; the paper: 5e4 to 2e5)"),
+              "shape penalty modulus on the second principal moment I^2, the "
+              "smaller in 2D (0: none; the paper: 5e4 to 2e5)"),
+    KEY_FLOAT(SP_SEC_SHAPE, "delta3", shape.delta3, 0.0, AT_LEAST(0.0),
+              UNBOUNDED, "E/L^7",
+              "3D only: shape penalty modulus on the smallest principal "
+              "moment I^3, the long axis's (0: none; docs/3d.md)"),
     KEY_ENUM(SP_SEC_SHAPE, "scheme", shape.scheme, SP_SHAPE_EXPLICIT, sp_shape_scheme_words,
              "-",
              "explicit: coefficients from c^n (the paper); implicit: the "
              "moments of the new state, linearised about c^n (stable for "
-             "stiff moduli; 2 extra right-hand sides per cell in each Newton "
+             "stiff moduli; 2 (3D: 3) extra right-hand sides per cell in each Newton "
              "iteration's solve)"),
     /* initial: the initial fields from files (src/initial.h) */
     KEY_PATH(SP_SEC_INITIAL, "from", initial.from,
@@ -1567,7 +1571,7 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
            "%.15g",
            file, t->dt, t->dt_min);
   SP_CHECK(!(t->scheme == SP_TIME_BDF2 && scene->shape.scheme == SP_SHAPE_IMPLICIT &&
-             (scene->shape.delta1 > 0 || scene->shape.delta2 > 0)),
+             (scene->shape.delta1 > 0 || scene->shape.delta2 > 0 || scene->shape.delta3 > 0)),
            SP_ERR_INPUT,
            "%s: time.scheme: expected be with shape.scheme implicit (its linearised moments "
            "need c^n, which a BDF2 step does not solve from), got bdf2",
@@ -1605,18 +1609,18 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
 #define SP_NOT_YET_3D "not yet in 3D (mesh.type box, ellipsoid; issue 29)"
 
 /** What a scene on a 3D mesh cannot ask for yet, each refused naming its
- *  key, rather than run wrong: the shape term and initial fields from
- *  files. */
+ *  key, rather than run wrong: initial fields from files (initial.from);
+ *  and on a 2D mesh, the third moment's shape.delta3. */
 static int check_3d(const sp_scene *scene, const char *file) {
-  if (sp_scene_dim(scene) != 3) return SP_OK;
+  if (sp_scene_dim(scene) != 3) {
+    SP_CHECK(scene->shape.delta3 == 0, SP_ERR_INPUT,
+             "%s: shape.delta3: the third principal moment is a 3D cell's (mesh.type box or "
+             "ellipsoid): expected 0 on a 2D mesh, got %.15g",
+             file, scene->shape.delta3);
+    return SP_OK;
+  }
   SP_CHECK(scene->n_lineage == 0, SP_ERR_INPUT,
            "%s: lineage: a lineage table is " SP_NOT_YET_3D ": expected none", file);
-  SP_CHECK(scene->shape.delta1 == 0, SP_ERR_INPUT,
-           "%s: shape.delta1: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
-           scene->shape.delta1);
-  SP_CHECK(scene->shape.delta2 == 0, SP_ERR_INPUT,
-           "%s: shape.delta2: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
-           scene->shape.delta2);
   SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
            "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
            ": expected none, got '%s'", file, scene->initial.from);

@@ -233,7 +233,9 @@ typedef enum { SP_SHAPE_EXPLICIT = 0, SP_SHAPE_IMPLICIT = 1 } sp_shape_scheme;
 /** shape: the shape penalty on principal moments (MODEL.md, paper sec. 3). */
 typedef struct {
   double delta1; /**< modulus on the larger principal moment I^1 */
-  double delta2; /**< modulus on the smaller principal moment I^2 */
+  double delta2; /**< modulus on the second principal moment I^2 (the
+                      smaller in 2D) */
+  double delta3; /**< 3D: modulus on the smallest principal moment I^3 */
   sp_shape_scheme scheme; /**< explicit (the paper) or linearised implicit */
 } sp_scene_shape;
 

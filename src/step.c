@@ -31,9 +31,9 @@ int sp_step_run_ends(const sp_run *run) {
   return !(run->t < tc->t_end - 1e-12 * tc->t_end && run->step < tc->max_steps);
 }
 
-/** The scene has a shape term (shape.delta1 or shape.delta2 > 0). */
+/** The scene has a shape term (a shape.delta* > 0). */
 static int shape_on(const sp_run_terms *terms) {
-  return terms->shape_delta1 > 0 || terms->shape_delta2 > 0;
+  return terms->shape_delta[0] > 0 || terms->shape_delta[1] > 0 || terms->shape_delta[2] > 0;
 }
 
 /** The step's source and shape coefficients from c^n (the state before the
@@ -48,8 +48,8 @@ static int explicit_terms(sp_run *run) {
   if (!shape_on(terms)) return SP_OK;
   /* from the observables of c^n; implicit steps follow the new moments
    * through the gains */
-  SP_CALL(sp_shape_coefficients(n_cells, cells->obs, cells->birth, terms->shape_delta1,
-                                terms->shape_delta2, cells->shape));
+  SP_CALL(sp_shape_coefficients(run->mesh->dim, n_cells, cells->obs, cells->birth,
+                                terms->shape_delta, cells->shape));
   /* the term is the derivative of the moments, which count c only where
    * c >= the observables' threshold: it acts there only */
   for (int k = 0; k < n_cells; ++k) cells->shape[k].threshold = run->opt.division.observe_threshold;

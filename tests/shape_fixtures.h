@@ -29,8 +29,47 @@ static inline double shape_energy_fd(const sp_mesh *mesh, const sp_layout *layou
                                      double delta2) {
   sp_cell_obs plus, minus;
   observe_plus_minus(mesh, layout, state, p, step, &plus, &minus);
-  return (sp_shape_energy(1, &plus, birth, delta1, delta2) -
-          sp_shape_energy(1, &minus, birth, delta1, delta2)) / (2 * step);
+  return (sp_shape_energy(1, &plus, birth, (double[3]){delta1, delta2, 0}) -
+          sp_shape_energy(1, &minus, birth, (double[3]){delta1, delta2, 0})) / (2 * step);
+}
+
+/** The implicit shape term's Jacobian against the residual: for a random
+ *  y (seed @p seed), J y (sp_solver_apply_jacobian with @p d, implicit)
+ *  against the central difference (F(s + h y) - F(s - h y)) / 2h,
+ *  h = 1e-6, and the sparse part alone (d explicit) against the same;
+ *  both as max |. - FD| / max |J y|. */
+static inline void implicit_jacobian_vs_fd(sp_solver solver, const sp_step_data *d,
+                                           const double *state, size_t n,
+                                           unsigned long long seed, double *err,
+                                           double *err_sparse) {
+  double *y = malloc(n * sizeof(double)), *jy = malloc(n * sizeof(double));
+  double *sparse_jy = malloc(n * sizeof(double)), *plus = malloc(n * sizeof(double));
+  double *minus = malloc(n * sizeof(double)), *fp = malloc(n * sizeof(double));
+  double *fm = malloc(n * sizeof(double));
+  for (size_t i = 0; i < n; ++i) y[i] = sp_random_symmetric(&seed);
+  sp_step_data explicit_d = *d;
+  explicit_d.shape_implicit = 0;
+  CHECK(sp_solver_apply_jacobian(solver, d, state, 0, y, jy) == 0, "%s",
+        sp_solver_last_error(solver));
+  CHECK(sp_solver_apply_jacobian(solver, &explicit_d, state, 0, y, sparse_jy) == 0, "%s",
+        sp_solver_last_error(solver));
+  const double h = 1e-6;
+  for (size_t i = 0; i < n; ++i) {
+    plus[i] = state[i] + h * y[i];
+    minus[i] = state[i] - h * y[i];
+  }
+  CHECK(sp_solver_residual(solver, d, plus, fp) == 0, "%s", sp_solver_last_error(solver));
+  CHECK(sp_solver_residual(solver, d, minus, fm) == 0, "%s", sp_solver_last_error(solver));
+  double e = 0, e_sparse = 0, scale = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double fd = (fp[i] - fm[i]) / (2 * h);
+    e = fmax(e, fabs(jy[i] - fd));
+    e_sparse = fmax(e_sparse, fabs(sparse_jy[i] - fd));
+    scale = fmax(scale, fabs(jy[i]));
+  }
+  *err = e / scale;
+  *err_sparse = e_sparse / scale;
+  free(y); free(jy); free(sparse_jy); free(plus); free(minus); free(fp); free(fm);
 }
 
 /** An elongated cell relaxing under the penalty (relax_ellipse). */
@@ -103,11 +142,11 @@ static inline relax_result relax_ellipse(relax_setup r) {
   out.i2_ref = birth.Iref[1];
   sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, r.linear);
   double energy = energy_total(solver, &model, state) +
-                  sp_shape_energy(1, &obs, &birth, 0.0, r.delta2);
+                  sp_shape_energy(1, &obs, &birth, (double[3]){0.0, r.delta2, 0});
   out.energy_start = energy;
   for (int n = 0; n < r.steps; ++n) {
     sp_shape_coef sc;
-    CHECK_OK(sp_shape_coefficients(1, &obs, &birth, 0.0, r.delta2, &sc));
+    CHECK_OK(sp_shape_coefficients(2, 1, &obs, &birth, (double[3]){0.0, r.delta2, 0}, &sc));
     sc.threshold = r.threshold; /* the term acts where the moments count c */
     memcpy(old, state, n_values * sizeof(double));
     sp_step_data data = {.dt = r.dt, .model = model, .state_old = old,
@@ -123,7 +162,7 @@ static inline relax_result relax_ellipse(relax_setup r) {
     out.newton_its += rep.newton_its;
     CHECK_OK(sp_cells_observe(mesh, layout, state, r.threshold, &obs));
     const double e = energy_total(solver, &model, state) +
-                     sp_shape_energy(1, &obs, &birth, 0.0, r.delta2);
+                     sp_shape_energy(1, &obs, &birth, (double[3]){0.0, r.delta2, 0});
     out.rise = fmax(out.rise, (e - energy) / fabs(energy));
     energy = e;
     ++out.steps_done;

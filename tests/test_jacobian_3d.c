@@ -2,7 +2,9 @@
  * tests (test_jacobian.c, test_jacobian_hand.c) assert them:
  *  - on random states with 1, 2 and 3 cells (SFad 16 and 32 unknowns, and
  *    DFad at 48), on a box of hexahedra whose nodes are moved at random
- *    (no two faces parallel) with a buffer layer, with a source present:
+ *    (no two faces parallel) with a buffer layer, with a source and the
+ *    shape term on the three moments present (src/shape.h; its implicit
+ *    variant's Jacobian: tests/test_shape_3d.c):
  *    hand = AD to 1e-12, AD = central differences to 1e-6, hand = FD to
  *    1e-6, DFad = AD to 1e-12;
  *  - a backward-Euler step of two touching spheres solved with the AD and
@@ -28,7 +30,14 @@ static void random_state(const sp_mesh *mesh, int n_cells, unsigned long long se
   sp_solver s = make_solver(mesh, layout, SP_SOLVER_JAC_HAND);
   double *state, *old, *source;
   random_step_arrays(layout, seed, &state, &old, &source);
-  sp_step_data data = {.dt = 1e-3, .model = paper_model(), .state_old = old, .source = source};
+  sp_shape_coef shape[3];
+  for (int k = 0; k < n_cells; ++k) {
+    shape[k] = (sp_shape_coef){.xc = 0.1 + 0.1 * k, .yc = 0.15 - 0.05 * k, .zc = 0.1 + 0.02 * k,
+                               .coef = {1e3 * (k + 1), -2e3, 1.5e3}};
+    rotated_axes(0.3 + k, 0.5, -0.2 * k, shape[k].v);
+  }
+  sp_step_data data = {.dt = 1e-3, .model = paper_model(), .state_old = old, .source = source,
+                       .shape = shape};
   const double hand_ad = jacobian_difference(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD);
   const double ad_fd = jacobian_difference(s, &data, state, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD);
   const double hand_fd = jacobian_difference(s, &data, state, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD);

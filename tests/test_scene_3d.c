@@ -6,14 +6,15 @@
  *    centred outside it, a cell without z: refused naming the key;
  *  - bad 3D input is refused as bad input (SP_ERR_INPUT) with a message
  *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
- *    the box, a z on a 2D mesh, and each feature not yet in 3D (shape
- *    term, initial fields from files) with "not yet"; pictures and
- *    checkpoints load;
+ *    the box, a z on a 2D mesh, and each feature not yet in 3D (initial
+ *    fields from files) with "not yet"; pictures and checkpoints load;
+ *    the shape term loads with its three moduli (shape.delta3 too), and
+ *    a 2D scene's shape.delta3 is refused;
  *  - divisions load in 3D (phase 2) with any layout.support, and so do
  *    local supports (explicit, or auto with 5 cells or with divisions that
  *    can make more than 4), as in 2D;
- *  - `softpack run` of such a scene exits 2, names the key and writes
- *    nothing. */
+ *  - `softpack run` of such a scene (and of a 2D one with shape.delta3)
+ *    exits 2, names the key and writes nothing. */
 #include <string.h>
 #include <sys/stat.h>
 
@@ -88,7 +89,28 @@ int main(void) {
     CHECK(scene->division.criterion != SP_DIVIDE_NONE, "%s: no division", divides[i]);
     sp_scene_destroy(&scene);
   }
-  refused(NULL, "shape: {delta2: 1e5}\n", "shape.delta2", "not yet in 3D");
+  /* the shape term in 3D: three moduli */
+  CHECK_OK(load(NULL, "shape: {delta1: 1e4, delta2: 2e4, delta3: 3e4, scheme: implicit}\n"
+                "time: {scheme: be}\n", &scene));
+  CHECK(scene->shape.delta1 == 1e4 && scene->shape.delta2 == 2e4 && scene->shape.delta3 == 3e4 &&
+            scene->shape.scheme == SP_SHAPE_IMPLICIT,
+        "shape in 3D: %g %g %g", scene->shape.delta1, scene->shape.delta2, scene->shape.delta3);
+  sp_scene_destroy(&scene);
+  refused(NULL, "shape: {delta3: -1}\n", "shape.delta3", NULL);
+  {
+    const char *flat = "mesh: {type: rectangle, x1: 0.6, y1: 0.5}\n"
+                       "output: {pictures: false}\n"
+                       "cells:\n  - {x: 0.3, y: 0.25, radius: 0.1}\n"
+                       "shape: {delta2: 1e5, delta3: 1e5}\n";
+    sp_scene *s2 = NULL;
+    const int rc = sp_scene_load_text("flat.yaml", flat, strlen(flat), 0, NULL, &s2);
+    printf("refused: %s\n", sp_error_message());
+    CHECK(rc == SP_ERR_INPUT && !s2, "2D scene with shape.delta3 accepted (rc %d)", rc);
+    CHECK(strstr(sp_error_message(), "shape.delta3") &&
+              strstr(sp_error_message(), "expected 0 on a 2D mesh"),
+          "the message: %s", sp_error_message());
+    sp_scene_destroy(&s2);
+  }
   /* local supports, explicit or by auto with 5 cells */
   CHECK_OK(load(NULL, "layout: {support: local}\n", &scene));
   CHECK(scene->layout.support == SP_SUPPORT_LOCAL, "layout.support %d", scene->layout.support);
@@ -140,10 +162,14 @@ int main(void) {
   /* the program: exit 2, the key named, nothing written */
   FILE *f = fopen("test_scene_3d.yaml", "w");
   CHECK(f != NULL, "cannot write the scene");
-  fprintf(f, "%s%s%sshape: {delta1: 1e5}\n", good_mesh, good_output, good_cells);
+  fprintf(f, "%s%s%sinitial: {from: run.h5}\n", good_mesh, good_output, good_cells);
   fclose(f);
-  run_refused("run test_scene_3d.yaml --quiet --out test_scene_3d_out", "shape.delta1",
+  run_refused("run test_scene_3d.yaml --quiet --out test_scene_3d_out", "initial.from",
               "not yet in 3D");
+  /* a 2D scene's shape.delta3 by --set */
+  run_refused("run " SP_SOURCE_DIR "/tests/scenes/rectangle_full.yaml --quiet --out "
+              "test_scene_3d_out --set shape.delta3=1e5",
+              "shape.delta3", "2D mesh");
   /* --set a picture width below its range: refused the same way */
   run_refused("run " SP_SOURCE_DIR "/tests/scenes/sphere_3d.yaml --quiet --out test_scene_3d_out "
               "--set output.pictures=true --set output.picture_width=10",

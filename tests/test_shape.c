@@ -160,7 +160,7 @@ static void test_derivatives(void) {
   const double delta1 = 3e4, delta2 = 7e4;
   sp_cell_birth birth = {.birth_mass = obs.mass, .Iref = {0.9 * obs.I1, 1.2 * obs.I2}};
   sp_shape_coef coef;
-  CHECK_OK(sp_shape_coefficients(1, &obs, &birth, delta1, delta2, &coef));
+  CHECK_OK(sp_shape_coefficients(2, 1, &obs, &birth, (double[3]){delta1, delta2, 0}, &coef));
   sp_solver solver = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
   double *without = malloc(n_values * sizeof(double)), *with = malloc(n_values * sizeof(double));
   sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = state};
@@ -220,7 +220,7 @@ static void test_round(void) {
   /* exactly round: isotropic, both coefficients the mean */
   sp_cell_obs round = make_obs(I, I, 0.0);
   sp_shape_coef s;
-  CHECK_OK(sp_shape_coefficients(1, &round, &birth, delta1, delta2, &s));
+  CHECK_OK(sp_shape_coefficients(2, 1, &round, &birth, (double[3]){delta1, delta2, 0}, &s));
   printf("  I1 = I2: coef = (%g, %g)\n", s.coef[0], s.coef[1]);
   CHECK(s.coef[0] == s.coef[1], "round: coef %g != %g", s.coef[0], s.coef[1]);
   CHECK_NEAR(s.coef[0], 0.5 * (c1 + c2), 1e-12 * fabs(c1 - c2));
@@ -230,8 +230,8 @@ static void test_round(void) {
   sp_cell_obs a = make_obs(I * (1 + tiny), I * (1 - tiny), 0.0);
   sp_cell_obs b = make_obs(I * (1 + tiny), I * (1 - tiny), PI / 2);
   sp_shape_coef sa, sb;
-  CHECK_OK(sp_shape_coefficients(1, &a, &birth, delta1, delta2, &sa));
-  CHECK_OK(sp_shape_coefficients(1, &b, &birth, delta1, delta2, &sb));
+  CHECK_OK(sp_shape_coefficients(2, 1, &a, &birth, (double[3]){delta1, delta2, 0}, &sa));
+  CHECK_OK(sp_shape_coefficients(2, 1, &b, &birth, (double[3]){delta1, delta2, 0}, &sb));
   double ta[3], tb[3], jump = 0;
   force_tensor(&sa, ta);
   force_tensor(&sb, tb);
@@ -247,7 +247,7 @@ static void test_round(void) {
     const double e = es[k];
     sp_cell_obs o = make_obs(I * (1 + e), I * (1 - e), 0.3);
     sp_shape_coef t;
-    CHECK_OK(sp_shape_coefficients(1, &o, &birth, delta1, delta2, &t));
+    CHECK_OK(sp_shape_coefficients(2, 1, &o, &birth, (double[3]){delta1, delta2, 0}, &t));
     const double e1 = 2 * delta1 * (birth.Iref[0] - o.I1), e2 = 2 * delta2 * (birth.Iref[1] - o.I2);
     const double bound = fmax(fabs(e1), fabs(e2));
     const int bounded = fabs(t.coef[0]) <= bound * (1 + 1e-14) &&
@@ -268,15 +268,17 @@ static void test_round(void) {
   sp_cell_obs bad[3] = {make_obs(0, 0, 0), make_obs(NAN, 1e-4, 0), make_obs(1e-4, -2e-4, 0)};
   sp_cell_birth births[3] = {birth, birth, birth};
   sp_shape_coef out[3];
-  CHECK_OK(sp_shape_coefficients(3, bad, births, delta1, delta2, out));
+  CHECK_OK(sp_shape_coefficients(2, 3, bad, births, (double[3]){delta1, delta2, 0}, out));
   for (int k = 0; k < 3; ++k)
     CHECK(out[k].coef[0] == 0 && out[k].coef[1] == 0 && isfinite(out[k].xc) &&
               isfinite(out[k].v[0][0]),
           "degenerate case %d: coef (%g, %g)", k, out[k].coef[0], out[k].coef[1]);
-  CHECK(sp_shape_coefficients(1, &round, &birth, -1.0, delta2, &s) == SP_ERR_INPUT,
+  CHECK(sp_shape_coefficients(2, 1, &round, &birth, (double[3]){-1.0, delta2, 0}, &s) ==
+            SP_ERR_INPUT,
         "negative delta1 accepted");
   sp_error_clear();
-  CHECK(sp_shape_energy(1, &round, &birth, 0.0, 0.0) == 0.0, "energy with zero moduli");
+  CHECK(sp_shape_energy(1, &round, &birth, (double[3]){0.0, 0.0, 0}) == 0.0,
+        "energy with zero moduli");
 
   /* a symmetric round tanh disk (I1 = I2 to round-off) with Iref pulling
    * the moments apart: a few solver steps stay finite, and obey the energy
@@ -306,7 +308,7 @@ static void test_round(void) {
                                     .Iref = {0.8 * obs.I1, 1.2 * obs.I2}};
   sp_solver solver = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
   const double e0 = energy_total(solver, &model, state) +
-                    sp_shape_energy(1, &obs, &disk_birth, delta1, delta2);
+                    sp_shape_energy(1, &obs, &disk_birth, (double[3]){delta1, delta2, 0});
   printf("  disk R = 0.1 on a 64x64 mesh, (I1 - I2)/(I1 + I2) = %.1e, Iref = (0.8, 1.2) I:\n",
          (obs.I1 - obs.I2) / (obs.I1 + obs.I2));
   printf("    step | energy (CH + shape) | I1/I2    | coef1     | coef2     | dPi_CH     | "
@@ -317,7 +319,7 @@ static void test_round(void) {
   double *with = malloc(n_values * sizeof(double)), *without = malloc(n_values * sizeof(double));
   for (int n = 1; n <= 5; ++n) {
     sp_shape_coef sc;
-    CHECK_OK(sp_shape_coefficients(1, &obs, &disk_birth, delta1, delta2, &sc));
+    CHECK_OK(sp_shape_coefficients(2, 1, &obs, &disk_birth, (double[3]){delta1, delta2, 0}, &sc));
     memcpy(old, state, n_values * sizeof(double));
     sp_step_data data = {.dt = 2e-4, .model = model, .state_old = old, .shape = &sc};
     sp_step_data bare = data;
@@ -331,7 +333,7 @@ static void test_round(void) {
     CHECK(rc == 0, "round disk, step %d: %s", n, rep.reason);
     CHECK_OK(sp_cells_observe(mesh, layout, state, 0.05, &obs));
     const double pi_new = energy_total(solver, &model, state);
-    const double e = pi_new + sp_shape_energy(1, &obs, &disk_birth, delta1, delta2);
+    const double e = pi_new + sp_shape_energy(1, &obs, &disk_birth, (double[3]){delta1, delta2, 0});
     double minus_dl = 0; /* sum_p D_p (c^n+1_p - c^n_p) */
     for (int p = 0; p < layout->n_pairs; ++p)
       minus_dl += (with[2 * p + 1] - without[2 * p + 1]) * (state[2 * p] - old[2 * p]);

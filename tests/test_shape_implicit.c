@@ -46,7 +46,7 @@ static void test_residual(void) {
   const sp_cell_birth birth = {.birth_mass = obs_old.mass,
                                .Iref = {0.9 * obs_old.I1, 1.2 * obs_old.I2}};
   sp_shape_coef coef;
-  CHECK_OK(sp_shape_coefficients(1, &obs_old, &birth, delta1, delta2, &coef));
+  CHECK_OK(sp_shape_coefficients(2, 1, &obs_old, &birth, (double[3]){delta1, delta2, 0}, &coef));
   coef.threshold = 0.0;
   sp_solver solver = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
   double *without = malloc(n_values * sizeof(double));
