@@ -92,8 +92,9 @@ std::unique_ptr<DirectSolver> make_klu();
 // (throws on several: Debian 13.2's Amesos2 is wrong there, STACK.md).
 std::unique_ptr<DirectSolver> make_amesos2_klu2(MPI_Comm comm);
 // GMRES (Belos) preconditioned by ILU(fill) (Ifpack2 RILUK; additive
-// Schwarz across ranks), to a residual of tolerance x |b|. fill and tolerance come from the caller
-// (the scene's solver.ilu_fill and solver.krylov_tol hold the defaults).
+// Schwarz across ranks), to a residual of tolerance x |b|. fill and
+// tolerance come from the caller (the scene's solver.ilu_fill and
+// solver.krylov_tol hold the defaults).
 struct KrylovOptions {
   int fill = -1;
   int restart = 100;

@@ -144,10 +144,16 @@ class KrylovSolver final : public DirectSolver {
 
   bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
     factored_ = false;
-    try {
-      if (!rows_ || !same_pattern || !rows_->same_pattern(A)) {
+    if (!rows_ || !same_pattern || !rows_->same_pattern(A)) {
+      try {
         if (!set_up(A, why)) return false;
+      } catch (const std::exception &e) {
+        rows_.reset();  // the next factor() starts over
+        why = std::string("GMRES/ILU: set-up failed: ") + e.what();
+        return false;
       }
+    }
+    try {
       rows_->set_values(A);
       prec_->compute();
     } catch (const std::exception &e) {
