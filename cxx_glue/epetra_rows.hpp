@@ -1,5 +1,5 @@
 // An Epetra copy of CsrRows (linear.hpp) for the backends that work on
-// Epetra matrices (Amesos2's KLU2, AztecOO): built once per pattern, rows
+// Epetra matrices (Amesos2's KLU2): built once per pattern, rows
 // distributed as given (contiguous in rank order); each set_values()
 // overwrites the values in place through a precomputed slot table, one pass.
 #ifndef SP_EPETRA_ROWS_HPP

@@ -2,8 +2,9 @@
 // the Newton code never depends on a backend and the backends never see the
 // Jacobian's Epetra objects (a later move to Tpetra is cheap). MUMPS, KLU,
 // SuperLU and SuperLU_DIST take the arrays through their own C interfaces;
-// KLU2 (Amesos2) and GMRES/ILU (AztecOO, Ifpack) build an Epetra matrix of
-// their own from them (epetra_rows.hpp).
+// KLU2 (Amesos2) builds an Epetra matrix of its own from them
+// (epetra_rows.hpp), GMRES/ILU (Belos, Ifpack2) a Tpetra one
+// (linear_krylov.cpp).
 #ifndef SP_LINEAR_HPP
 #define SP_LINEAR_HPP
 
@@ -90,9 +91,10 @@ std::unique_ptr<DirectSolver> make_klu();
 // KLU2 through Amesos2 on an Epetra copy of the rows; one process only
 // (throws on several: Debian 13.2's Amesos2 is wrong there, STACK.md).
 std::unique_ptr<DirectSolver> make_amesos2_klu2(MPI_Comm comm);
-// GMRES preconditioned by ILU(fill) (additive Schwarz across ranks), to a
-// residual of tolerance x |b|. fill and tolerance come from the caller
-// (the scene's solver.ilu_fill and solver.krylov_tol hold the defaults).
+// GMRES (Belos) preconditioned by ILU(fill) (Ifpack2 RILUK; additive
+// Schwarz across ranks), to a residual of tolerance x |b|. fill and
+// tolerance come from the caller (the scene's solver.ilu_fill and
+// solver.krylov_tol hold the defaults).
 struct KrylovOptions {
   int fill = -1;
   int restart = 100;
@@ -100,6 +102,9 @@ struct KrylovOptions {
   double tolerance = 0;
 };
 std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options);
+// Kokkos initialised once per process (Amesos2's and Tpetra's arrays are
+// Kokkos views), finalised at exit if this started it (linear_krylov.cpp).
+void ensure_kokkos();
 
 // The library behind each backend and its version, from the headers the
 // glue was compiled with (softpack info); static text. SP_STR makes a

@@ -6,12 +6,10 @@
 // in place and refactors numerically.
 #include <Amesos2.hpp>
 #include <Epetra_MultiVector.h>
-#include <Kokkos_Core.hpp>
 #include <Teuchos_RCP.hpp>
 #include <Trilinos_version.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <exception>
 #include <stdexcept>
 #include <vector>
@@ -21,17 +19,6 @@
 
 namespace sp {
 namespace {
-
-// Amesos2 keeps its arrays in Kokkos views, which need Kokkos initialised
-// (the Serial space in Debian's build: no threads). Done once per process,
-// finalised at exit if we started it.
-void ensure_kokkos() {
-  if (Kokkos::is_initialized()) return;
-  Kokkos::initialize();
-  std::atexit([] {
-    if (Kokkos::is_initialized()) Kokkos::finalize();
-  });
-}
 
 class Amesos2Klu2 final : public DirectSolver {
  public:

@@ -1,55 +1,167 @@
-// GMRES (AztecOO) preconditioned by an incomplete LU factorisation
-// (Ifpack ILU(k); under MPI additive Schwarz, one ILU per rank) on an
-// Epetra copy of the CSR rows. factor() computes the ILU of A; solve()
-// runs GMRES on the A of the last factor() to a relative residual.
-#include <AztecOO.h>
-#include <Ifpack.h>
-#include <Ifpack_Preconditioner.h>
+// GMRES (Belos' pseudo-block GMRES) preconditioned by an incomplete LU
+// factorisation (Ifpack2 RILUK, ILU(k); under MPI additive Schwarz without
+// overlap, one ILU per rank) on a Tpetra copy of the CSR rows: global
+// ordinal long long, the only one Debian's Trilinos 13.2 instantiates
+// (docs/building.md). factor() computes the ILU of A; solve() runs GMRES on
+// the A of the last factor() to a residual of tolerance x |b|.
+//
+// The same method as the AztecOO + Ifpack solver this replaces (issue 31:
+// Trilinos 17 removes both): the preconditioner on the right (A M^-1 y = b,
+// x = M^-1 y, as AztecOO's GMRES), the start x0 = 0, the test
+// |b - A x| <= tolerance |b| (AZ_conv = AZ_rhs) on the recursive residual
+// and then, as AztecOO does, on the true one; classical Gram-Schmidt with
+// a second pass (AztecOO's AZ_classic, Belos' ICGS); the restart and the
+// iteration limit. One process: RILUK alone, several: Schwarz, as Ifpack's
+// factory did ("ILU" with overlap 0). Round-off differs (another
+// orthogonalisation code, another ILU code).
+//
+// The Tpetra graph is built once per pattern; each factor() writes the
+// values into the matrix's own array through a slot table (one pass, the
+// graph stays), recomputes the ILU's values and keeps its symbolic part.
+#include <BelosLinearProblem.hpp>
+#include <BelosSolverFactory_Tpetra.hpp>
+#include <BelosTpetraAdapter.hpp>
+#include <Ifpack2_Factory.hpp>
+#include <Kokkos_Core.hpp>
+#include <Teuchos_DefaultMpiComm.hpp>
 #include <Teuchos_ParameterList.hpp>
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Map.hpp>
+#include <Tpetra_MultiVector.hpp>
+#include <Trilinos_version.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
-#include "epetra_rows.hpp"
 #include "linear.hpp"
 
 namespace sp {
+
+// Amesos2 and Tpetra keep their arrays in Kokkos views, which need Kokkos
+// initialised (the Serial space in Debian's build: no threads). Done once
+// per process, finalised at exit if we started it.
+void ensure_kokkos() {
+  if (Kokkos::is_initialized()) return;
+  Kokkos::initialize();
+  std::atexit([] {
+    if (Kokkos::is_initialized()) Kokkos::finalize();
+  });
+}
+
 namespace {
+
+using GO = long long;  // Debian 13.2 instantiates Tpetra for GO = long long only
+using Map = Tpetra::Map<int, GO>;
+using Graph = Tpetra::CrsGraph<int, GO>;
+using Matrix = Tpetra::CrsMatrix<double, int, GO>;
+using RowMatrix = Tpetra::RowMatrix<double, int, GO>;
+using MV = Tpetra::MultiVector<double, int, GO>;
+using OP = Tpetra::Operator<double, int, GO>;
+using Prec = Ifpack2::Preconditioner<double, int, GO>;
+
+// A Tpetra copy of CsrRows: its graph built once (rows contiguous in rank
+// order, as given); set_values() overwrites the values in place.
+class TpetraRows {
+ public:
+  TpetraRows(const Teuchos::RCP<const Teuchos::Comm<int>> &comm, const CsrRows &A)
+      : n_global_(A.n_global), n_rows_(A.n_rows), nnz_(A.row_ptr[A.n_rows]) {
+    // (global size, local size): rows numbered contiguously in rank order
+    map_ = Teuchos::rcp(new Map((Tpetra::global_size_t)A.n_global, (size_t)A.n_rows, 0, comm));
+    if (A.n_rows > 0 && map_->getMinGlobalIndex() != A.first_row)
+      throw std::logic_error("Tpetra copy: rows are not contiguous in rank order");
+    std::vector<size_t> lengths(A.n_rows);
+    for (int i = 0; i < A.n_rows; ++i) lengths[i] = A.row_ptr[i + 1] - A.row_ptr[i];
+    auto graph = Teuchos::rcp(new Graph(map_, Teuchos::ArrayView<const size_t>(lengths)));
+    std::vector<GO> cols;
+    for (int i = 0; i < A.n_rows; ++i) {
+      cols.assign(A.col + A.row_ptr[i], A.col + A.row_ptr[i + 1]);
+      graph->insertGlobalIndices(A.first_row + i, Teuchos::ArrayView<const GO>(cols));
+    }
+    graph->fillComplete();
+    matrix_ = Teuchos::rcp(new Matrix(graph));
+    matrix_->fillComplete();
+    // slot_[k]: entry k of the caller's rows in the matrix's value array
+    const auto local = matrix_->getLocalMatrixHost();
+    const auto &colmap = *matrix_->getColMap();
+    slot_.resize(nnz_);
+    std::vector<std::pair<GO, size_t>> gid_pos;
+    for (int i = 0; i < A.n_rows; ++i) {
+      const size_t begin = local.graph.row_map(i), end = local.graph.row_map(i + 1);
+      gid_pos.clear();
+      for (size_t p = begin; p < end; ++p)
+        gid_pos.emplace_back(colmap.getGlobalElement(local.graph.entries(p)), p);
+      std::sort(gid_pos.begin(), gid_pos.end());
+      for (int k = A.row_ptr[i]; k < A.row_ptr[i + 1]; ++k) {
+        const auto key = std::make_pair((GO)A.col[k], (size_t)0);
+        auto it = std::lower_bound(gid_pos.begin(), gid_pos.end(), key);
+        if (it == gid_pos.end() || it->first != A.col[k])
+          throw std::logic_error("Tpetra copy: entry missing from the matrix");
+        slot_[k] = it->second;
+      }
+    }
+    lhs_ = Teuchos::rcp(new MV(map_, 1));
+    rhs_ = Teuchos::rcp(new MV(map_, 1));
+  }
+  // A has this pattern: same rows on this rank, same number of entries
+  // (the caller says whether the pattern is the same; this guards sizes).
+  bool same_pattern(const CsrRows &A) const {
+    return A.n_global == n_global_ && A.n_rows == n_rows_ && A.row_ptr[A.n_rows] == nnz_;
+  }
+  void set_values(const CsrRows &A) {
+    matrix_->resumeFill();
+    {
+      auto values = matrix_->getLocalMatrixHost().values;
+      for (size_t k = 0; k < slot_.size(); ++k) values(slot_[k]) = A.val[k];
+    }
+    auto params = Teuchos::rcp(new Teuchos::ParameterList);
+    params->set("No Nonlocal Changes", true);  // the graph is fixed: no communication
+    matrix_->fillComplete(matrix_->getDomainMap(), matrix_->getRangeMap(), params);
+  }
+  Teuchos::RCP<Matrix> matrix() const { return matrix_; }
+  Teuchos::RCP<MV> lhs() const { return lhs_; }
+  Teuchos::RCP<MV> rhs() const { return rhs_; }
+  int n_local() const { return n_rows_; }
+
+ private:
+  int n_global_, n_rows_, nnz_;
+  Teuchos::RCP<const Map> map_;
+  Teuchos::RCP<Matrix> matrix_;
+  Teuchos::RCP<MV> lhs_, rhs_;
+  std::vector<size_t> slot_;
+};
 
 class KrylovSolver final : public DirectSolver {
  public:
-  KrylovSolver(MPI_Comm comm, const KrylovOptions &o) : comm_(comm), o_(o) {}
+  KrylovSolver(MPI_Comm comm, const KrylovOptions &o)
+      : comm_(Teuchos::rcp(new Teuchos::MpiComm<int>(comm))), o_(o) {
+    ensure_kokkos();
+  }
 
   bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
+    factored_ = false;
     if (!rows_ || !same_pattern || !rows_->same_pattern(A)) {
-      prec_.reset();
-      gmres_.reset();
-      rows_ = std::make_unique<EpetraRows>(comm_, A);
-      Ifpack factory;
-      prec_.reset(factory.Create("ILU", &rows_->matrix(), 0));
-      Teuchos::ParameterList p;
-      p.set("fact: level-of-fill", o_.fill);
-      prec_->SetParameters(p);
-      if (prec_->Initialize() != 0) {
-        why = "ILU: symbolic set-up failed";
-        prec_.reset();
+      try {
+        if (!set_up(A, why)) return false;
+      } catch (const std::exception &e) {
         rows_.reset();  // the next factor() starts over
-        factored_ = false;
+        why = std::string("GMRES/ILU: set-up failed: ") + e.what();
         return false;
       }
-      gmres_ = std::make_unique<AztecOO>(&rows_->matrix(), &rows_->lhs(), &rows_->rhs());
-      gmres_->SetPrecOperator(prec_.get());
-      gmres_->SetAztecOption(AZ_solver, AZ_gmres);
-      gmres_->SetAztecOption(AZ_kspace, o_.restart);
-      gmres_->SetAztecOption(AZ_conv, AZ_rhs);
-      gmres_->SetAztecOption(AZ_output, AZ_none);
-      ++symbolic_;
     }
-    rows_->set_values(A);
-    factored_ = prec_->Compute() == 0;
-    if (!factored_) why = "ILU: factorisation failed (zero pivot?)";
-    return factored_;
+    try {
+      rows_->set_values(A);
+      prec_->compute();
+    } catch (const std::exception &e) {
+      why = std::string("ILU: factorisation failed (zero pivot?): ") + e.what();
+      return false;
+    }
+    factored_ = true;
+    return true;
   }
 
   bool solve(const double *b, double *x, std::string &why) override {
@@ -58,20 +170,34 @@ class KrylovSolver final : public DirectSolver {
       return false;
     }
     const int n = rows_->n_local();
-    std::copy(b, b + n, rows_->rhs().Values());
-    rows_->lhs().PutScalar(0.0);
-    gmres_->Iterate(o_.max_iterations, o_.tolerance);
-    const double *status = gmres_->GetAztecStatus();
-    iterations_ += (long)status[AZ_its];
-    if (status[AZ_why] != AZ_normal) {
-      char text[128];
+    Belos::ReturnType result;
+    int its = 0;
+    try {
+      {
+        auto rhs = rows_->rhs()->getLocalViewHost(Tpetra::Access::OverwriteAll);
+        for (int i = 0; i < n; ++i) rhs(i, 0) = b[i];
+      }
+      rows_->lhs()->putScalar(0.0);
+      problem_->setProblem();  // the new right-hand side and the initial residual
+      result = gmres_->solve();
+      its = gmres_->getNumIters();
+    } catch (const std::exception &e) {
+      why = std::string("GMRES: the solve failed: ") + e.what();
+      return false;
+    }
+    iterations_ += its;
+    if (result != Belos::Converged) {
+      char text[160];
       std::snprintf(text, sizeof text,
-                    "GMRES: no convergence to %g x |b| in %d iterations (AztecOO status %d)",
-                    o_.tolerance, (int)status[AZ_its], (int)status[AZ_why]);
+                    "GMRES: no convergence to %g x |b| in %d iterations (Belos: %s)", o_.tolerance,
+                    its,
+                    gmres_->isLOADetected() ? "loss of accuracy: the true residual stays above it"
+                                            : "unconverged");
       why = text;
       return false;
     }
-    std::copy(rows_->lhs().Values(), rows_->lhs().Values() + n, x);
+    auto lhs = rows_->lhs()->getLocalViewHost(Tpetra::Access::ReadOnly);
+    for (int i = 0; i < n; ++i) x[i] = lhs(i, 0);
     return true;
   }
 
@@ -79,11 +205,71 @@ class KrylovSolver final : public DirectSolver {
   int symbolic_count() const override { return symbolic_; }
 
  private:
-  Epetra_MpiComm comm_;
+  // A new pattern: the Tpetra copy, the ILU's symbolic part, the GMRES.
+  bool set_up(const CsrRows &A, std::string &why) {
+    gmres_ = Teuchos::null;
+    problem_ = Teuchos::null;
+    prec_ = Teuchos::null;
+    rows_.reset();
+    auto rows = std::make_unique<TpetraRows>(comm_, A);
+    Teuchos::RCP<const RowMatrix> matrix = rows->matrix();
+    // Ifpack's ILU (Ifpack_ILU, Ifpack_CrsRiluk) and Ifpack2's RILUK take
+    // the same parameters with the same defaults: no relaxation, no
+    // diagonal perturbation.
+    Teuchos::ParameterList ilu;
+    ilu.set("fact: iluk level-of-fill", o_.fill);
+    ilu.set("fact: relax value", 0.0);
+    ilu.set("fact: absolute threshold", 0.0);
+    ilu.set("fact: relative threshold", 1.0);
+    Teuchos::RCP<Prec> prec;
+    if (comm_->getSize() == 1) {
+      prec = Ifpack2::Factory::create<RowMatrix>("RILUK", matrix);
+      prec->setParameters(ilu);
+    } else {
+      prec = Ifpack2::Factory::create<RowMatrix>("SCHWARZ", matrix);
+      Teuchos::ParameterList schwarz;
+      schwarz.set("schwarz: overlap level", 0);
+      schwarz.set("schwarz: combine mode", "ZERO");
+      schwarz.set("schwarz: use reordering", false);
+      schwarz.set("inner preconditioner name", "RILUK");
+      schwarz.set("inner preconditioner parameters", ilu);
+      prec->setParameters(schwarz);
+    }
+    try {
+      prec->initialize();
+    } catch (const std::exception &e) {
+      why = std::string("ILU: symbolic set-up failed: ") + e.what();
+      return false;  // rows_ stays empty: the next factor() starts over
+    }
+    auto problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>(
+        rows->matrix(), rows->lhs(), rows->rhs()));
+    problem->setRightPrec(prec);
+    auto params = Teuchos::rcp(new Teuchos::ParameterList);
+    params->set("Num Blocks", o_.restart);
+    params->set("Maximum Iterations", o_.max_iterations);
+    // the iteration limit ends the solve, not the restarts
+    params->set("Maximum Restarts", o_.max_iterations);
+    params->set("Convergence Tolerance", o_.tolerance);
+    params->set("Implicit Residual Scaling", "Norm of RHS");
+    params->set("Explicit Residual Scaling", "Norm of RHS");
+    params->set("Orthogonalization", "ICGS");
+    params->set("Verbosity", 0);  // failures are reported through why
+    Belos::SolverFactory<double, MV, OP> factory;
+    gmres_ = factory.create("Pseudoblock GMRES", params);
+    gmres_->setProblem(problem);
+    rows_ = std::move(rows);
+    prec_ = prec;
+    problem_ = problem;
+    ++symbolic_;
+    return true;
+  }
+
+  Teuchos::RCP<const Teuchos::Comm<int>> comm_;
   KrylovOptions o_;
-  std::unique_ptr<EpetraRows> rows_;
-  std::unique_ptr<Ifpack_Preconditioner> prec_;
-  std::unique_ptr<AztecOO> gmres_;
+  std::unique_ptr<TpetraRows> rows_;
+  Teuchos::RCP<Prec> prec_;
+  Teuchos::RCP<Belos::LinearProblem<double, MV, OP>> problem_;
+  Teuchos::RCP<Belos::SolverManager<double, MV, OP>> gmres_;
   bool factored_ = false;
   int symbolic_ = 0;
   long iterations_ = 0;
@@ -95,6 +281,9 @@ std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &op
   return std::make_unique<KrylovSolver>(comm, options);
 }
 
-const char *krylov_version() { return "AztecOO GMRES, Ifpack ILU(k)"; }
+const char *krylov_version() {
+  return "Belos GMRES, Ifpack2 RILUK ILU(k) (Trilinos " TRILINOS_VERSION_STRING
+         "; additive Schwarz under MPI)";
+}
 
 }  // namespace sp

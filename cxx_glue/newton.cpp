@@ -312,11 +312,14 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       break;
     case SP_SOLVER_KLU2:
       // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
-      // ranks (STACK.md, docs/parallel.md): one process only.
+      // ranks (a gcc 12 miscompile, docs/building.md): one process only.
+      // Every rank refuses here, at set-up, before anything is written.
       if (P > 1)
         throw input_error("solver.linear: klu2 runs on one MPI process only (this run has " +
-                                 std::to_string(P) +
-                                 "); use superlu_dist, mumps or klu with several processes");
+                          std::to_string(P) +
+                          "): Debian's Amesos2 KLU2 (Trilinos 13.2) is miscompiled by gcc 12 and "
+                          "gives wrong answers on 2 or more processes (docs/building.md); use "
+                          "superlu_dist, mumps or klu with several processes");
       direct = make_amesos2_klu2(comm);
       break;
     case SP_SOLVER_GMRES_ILU: {

@@ -387,9 +387,10 @@ static const sp_key sp_keys[] = {
     KEY_ENUM(SP_SEC_SOLVER, "linear", solver.linear, SP_LINEAR_MUMPS,
              sp_linear_words, "-",
              "linear solver of each Newton step: direct (superlu, "
-             "superlu_dist, mumps, klu: Amesos' KLU, klu2: Amesos2's KLU2, "
-             "one process) or GMRES with an ILU(k) preconditioner "
-             "(gmres_ilu)"),
+             "superlu_dist, mumps, klu: SuiteSparse's KLU, klu2: Amesos2's "
+             "KLU2, one process only: Debian's is wrong on several, "
+             "docs/building.md) or GMRES with an ILU(k) preconditioner "
+             "(gmres_ilu: Belos GMRES, Ifpack2 RILUK, one ILU per process)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
               ABOVE(0.0), BELOW(1.0), "-",
               "Newton: residual reduction relative to the first residual (with "

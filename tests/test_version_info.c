@@ -67,6 +67,12 @@ int main(int argc, char **argv) {
   CHECK(sp_solver_linear_backend(SP_SOLVER_MUMPS, &mumps) == 1 && mumps &&
             strstr(mumps, "MUMPS") != NULL && strstr(mumps, "Amesos") == NULL,
         "mumps is served by '%s', want MUMPS' own interface", mumps ? mumps : "(none)");
+  /* gmres_ilu: Belos and Ifpack2 (no AztecOO, Ifpack: issue 31) */
+  const char *gmres = NULL;
+  CHECK(sp_solver_linear_backend(SP_SOLVER_GMRES_ILU, &gmres) == 1 && gmres &&
+            strstr(gmres, "Belos") != NULL && strstr(gmres, "Ifpack2") != NULL &&
+            strstr(gmres, "AztecOO") == NULL,
+        "gmres_ilu is served by '%s', want Belos and Ifpack2", gmres ? gmres : "(none)");
   /* The BLAS line names a file that exists. */
   line_after(out, "BLAS: ", value, sizeof value);
   const char *from = strstr(value, "dgemm_ from ");
