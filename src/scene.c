@@ -637,7 +637,8 @@ static const sp_key sp_keys[] = {
     LINEAGE_ENUM("axis", axis, SP_AXIS_LONG, sp_axis_words, "-",
                  "the cut's normal: long (the cell's long principal axis, the paper's "
                  "rule), fixed (direction_x, _y, _z) or perpendicular (to the parent's "
-                 "own cut normal: turned by 90 degrees in 2D); long and perpendicular "
+                 "own cut normal: turned by 90 degrees in 2D, in 3D the long axis "
+                 "projected on the plane normal to it); long and perpendicular "
                  "point to +x (then +y, +z), so the first daughter is the one at lower x"),
     LINEAGE_FLOAT("direction_x", direction[0], NAN, UNBOUNDED, UNBOUNDED, "-",
                   "axis fixed: x component of the cut's normal (any length > 0)"),
@@ -1556,8 +1557,6 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
  *  and initial fields from files. */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) return SP_OK;
-  SP_CHECK(scene->n_lineage == 0, SP_ERR_INPUT,
-           "%s: lineage: a lineage table is " SP_NOT_YET_3D ": expected none", file);
   SP_CHECK(scene->shape.delta1 == 0, SP_ERR_INPUT,
            "%s: shape.delta1: the shape term is " SP_NOT_YET_3D ": expected 0, got %.15g", file,
            scene->shape.delta1);
