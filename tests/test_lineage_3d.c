@@ -25,7 +25,7 @@
 #include "scene.h"
 #include "stepper.h"
 
-#define OUT "test_lineage_3d"
+#define OUT "test_lineage_3d_out"
 enum { MAX_CELLS = 4, CAP = 200 };
 
 static const char divisions_header[] =
