@@ -11,6 +11,13 @@
 /** A component below this (of a unit vector) does not decide its sign. */
 #define SP_LINEAGE_SIGN_EPS 1e-9
 
+/** The perpendicular rule in 3D: the long axis's part perpendicular to the
+ *  parent's cut normal names the new normal when it is at least this long
+ *  (the long axis at least 1e-6 rad off the parent's normal); closer to it
+ *  the projection's direction is round-off, and the rule falls back to
+ *  any_perpendicular's fixed choice. */
+#define SP_LINEAGE_PROJECTION_MIN 1e-6
+
 int sp_lineage_from_scene(const sp_scene *scene, sp_lineage *out) {
   *out = (sp_lineage){0};
   for (int i = 0; i < scene->n_cells; ++i) out->named |= scene->cells[i].name[0] != '\0';
@@ -97,6 +104,20 @@ static int unit(const double v[3], double out[3]) {
   return 1;
 }
 
+/** The unit vector along @p v without its part along the unit @p p, into
+ *  @p out (which may be @p v); 0 (and @p out untouched) when that part is
+ *  shorter than SP_LINEAGE_PROJECTION_MIN: @p v (nearly) along @p p names no
+ *  direction perpendicular to it. */
+static int project_out(const double v[3], const double p[3], double out[3]) {
+  const double along = v[0] * p[0] + v[1] * p[1] + v[2] * p[2];
+  double w[3];
+  for (int d = 0; d < 3; ++d) w[d] = v[d] - along * p[d];
+  const double norm = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  if (!(norm >= SP_LINEAGE_PROJECTION_MIN)) return 0;
+  for (int d = 0; d < 3; ++d) out[d] = w[d] / norm;
+  return 1;
+}
+
 /** A unit vector perpendicular to the unit @p p: in 2D p turned by +90
  *  degrees; in 3D p crossed with the coordinate axis least along it. */
 static void any_perpendicular(const double p[3], int dim, double out[3]) {
@@ -126,11 +147,11 @@ void sp_lineage_normal(const sp_lineage_entry *e, int dim, const double long_axi
   if (!e) return; /* the paper's cut, exactly as it always was */
   if (e->axis == SP_AXIS_PERPENDICULAR && unit(parent_normal, p)) {
     /* 2D: the parent's normal turned by 90 degrees (exactly); 3D: the long
-     * axis without its part along the parent's normal */
-    double along = 0, v[3];
-    for (int d = 0; d < dim; ++d) along += long_axis[d] * p[d];
-    for (int d = 0; d < 3; ++d) v[d] = d < dim ? long_axis[d] - along * p[d] : 0.0;
-    if (dim == 2 || !unit(v, normal)) any_perpendicular(p, dim, normal);
+     * axis without its part along the parent's normal, normalised (twice:
+     * the second pass leaves a part along p of round-off, ~1e-16, even
+     * when the projection is short) */
+    if (dim == 2 || !project_out(long_axis, p, normal) || !project_out(normal, p, normal))
+      any_perpendicular(p, dim, normal);
   }
   orient(normal, dim);
 }

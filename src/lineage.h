@@ -81,10 +81,14 @@ double sp_lineage_due_time(const sp_lineage_entry *e, const sp_cell_birth *birth
  *
  * - long: @p long_axis (the cell's long principal axis);
  * - fixed: the entry's direction;
- * - perpendicular: perpendicular to @p parent_normal (the normal of the cut
- *   that made the cell), the one closest to @p long_axis (the long axis
- *   projected on the plane normal to @p parent_normal): in 2D the parent's
- *   normal turned by 90 degrees; a zero @p parent_normal gives long.
+ * - perpendicular: perpendicular to @p parent_normal p (the normal of the
+ *   cut that made the cell): in 2D p turned by 90 degrees; in 3D the one
+ *   closest to @p long_axis l, l - (l . p) p normalised (the long axis
+ *   projected on the plane normal to p; orthogonal to p to round-off).
+ *   When that projection is shorter than 1e-6 (l within 1e-6 rad of p: the
+ *   cell is longest along its parent's normal and names no direction in
+ *   that plane), the fallback is p crossed with the coordinate axis least
+ *   along p, normalised. A zero @p parent_normal gives long.
  * long and perpendicular are oriented so that the first component above
  * 1e-9 in size (x, then y, then z) is positive: the first daughter (on the
  * side the normal points away from) is the one at lower x. fixed keeps the
@@ -98,7 +102,7 @@ void sp_lineage_normal(const sp_lineage_entry *e, int dim, const double long_axi
  *        observables: the cut normal of @p obs (sp_division_plane's: in 2D
  *        v1 turned by +90 degrees, in 3D the long axis v3) into @p normal,
  *        and the converse, @p obs made to give @p normal (v1, v2 in 2D,
- *        v3 in 3D; a lineage table is refused on a 3D mesh for now).
+ *        v3 in 3D).
  */
 void sp_lineage_obs_normal(const sp_cell_obs *obs, int dim, double normal[3]);
 void sp_lineage_set_obs_normal(sp_cell_obs *obs, const double normal[3]);

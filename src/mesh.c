@@ -718,6 +718,54 @@ int sp_mesh_ellipsoid(int refinements, double a, double b, double c, int buffer_
 }
 
 /* ------------------------------------------------------------------------ */
+/* The coverslip: the ellipse (ellipsoid) cut by two planes                 */
+/* ------------------------------------------------------------------------ */
+
+/** The semi-axes of an ellipse (ellipsoid) mesh, from its bounds. */
+static void mesh_semi_axes(const sp_mesh *mesh, double semi[3]) {
+  static const int hi[3] = {2, 3, 5};
+  for (int d = 0; d < 3; ++d) semi[d] = d < mesh->dim ? mesh->bounds[hi[d]] : 0.0;
+}
+
+int sp_mesh_flatten(sp_mesh *mesh, double h) {
+  SP_CHECK(mesh && mesh->is_ellipse, SP_ERR_INPUT,
+           "sp_mesh_flatten: expected an ellipse or ellipsoid mesh");
+  const int dim = mesh->dim, last = dim - 1;
+  double semi[3];
+  mesh_semi_axes(mesh, semi);
+  SP_CHECK(h > 0 && h < semi[last], SP_ERR_INPUT,
+           "sp_mesh_flatten: expected 0 < h < %.15g (the last semi-axis), got %.15g", semi[last],
+           h);
+  for (int i = 0; i < mesh->n_nodes; ++i) {
+    double *x = mesh->xy + (size_t)dim * i;
+    double across = 0; /* sum over the other axes of (x_d / s_d)^2 */
+    for (int d = 0; d < last; ++d) across += (x[d] / semi[d]) * (x[d] / semi[d]);
+    const double t = x[last] / semi[last];
+    const double rho = sqrt(across + t * t);
+    if (rho <= 1) { /* Omega: the column's extent T to min(T, h) */
+      const double column = semi[last] * sqrt(fmax(0.0, 1 - across));
+      if (column > h) x[last] *= h / column;
+    } else { /* the buffer: the surface map, scaled by rho */
+      x[last] = copysign(fmin(fabs(x[last]), rho * h), x[last]);
+    }
+  }
+  mesh->flatten = h;
+  mesh_finish(mesh);
+  return SP_OK;
+}
+
+double sp_mesh_flattened_measure(int dim, const double semi[3], double h) {
+  const double pi = 3.14159265358979323846;
+  const double c = semi[dim - 1];
+  if (h > c) h = c;
+  if (dim == 2) {
+    const double u = h / c;
+    return 2 * semi[0] * c * (u * sqrt(1 - u * u) + asin(u));
+  }
+  return pi * semi[0] * semi[1] * (2 * h - 2 * h * h * h / (3 * c * c));
+}
+
+/* ------------------------------------------------------------------------ */
 /* Queries                                                                  */
 /* ------------------------------------------------------------------------ */
 
@@ -745,7 +793,9 @@ int sp_mesh_contains(const sp_mesh *mesh, const double *x) {
   if (mesh->is_ellipse) {
     double level = 0;
     for (int d = 0; d < mesh->dim; ++d) level += (x[d] / bd[hi[d]]) * (x[d] / bd[hi[d]]);
-    return level <= 1 + SP_MESH_CONTAINS_TOL;
+    const double cut = mesh->flatten; /* (0: none) */
+    return level <= 1 + SP_MESH_CONTAINS_TOL &&
+           (!(cut > 0) || fabs(x[mesh->dim - 1]) <= cut * (1 + SP_MESH_CONTAINS_TOL));
   }
   int inside = 1;
   for (int d = 0; d < mesh->dim; ++d) {

@@ -36,6 +36,9 @@ typedef struct sp_mesh {
   double bounds[6]; /**< Omega: rectangle x0, y0, x1, y1; ellipse 0, 0, a, b;
                          box x0, y0, x1, y1, z0, z1; ellipsoid 0, 0, a, b,
                          0, c */
+  double flatten;   /**< ellipse, ellipsoid: > 0 when Omega is cut by the
+                         planes |x_{dim-1}| <= flatten (the coverslip:
+                         |y| in 2D, |z| in 3D; sp_mesh_flatten); 0: no cut */
   double h;         /**< largest element edge length */
   /** The Q1 geometry at element e's Gauss point q (sp_q1_point), made once
    *  with the mesh so that loops over elements (src/cells.c) need not
@@ -90,6 +93,34 @@ int sp_mesh_box(double x0, double y0, double z0, double x1, double y1, double z1
  */
 int sp_mesh_ellipsoid(int refinements, double a, double b, double c, int buffer_layers,
                       double buffer_width, sp_mesh **out);
+
+/**
+ * @brief Cut the ellipse (ellipsoid) mesh by the planes |x_{dim-1}| <= @p h
+ *        (|y| in 2D, |z| in 3D): an embryo flattened under a coverslip.
+ *
+ * The nodes are moved, nothing is added or removed. In Omega each column
+ * along the last axis (x_{dim-1} = t, the others fixed) is scaled: its
+ * extent [-T, T] on the ellipse(oid), T = c sqrt(1 - sum_{d<last}
+ * (x_d/s_d)^2) with c the last semi-axis, goes to [-min(T, h), min(T, h)]
+ * (t -> t min(T, h)/T). So Omega becomes exactly the cut ellipse(oid)
+ * (its boundary nodes lie on the planes or on the ellipse(oid)) and the
+ * map, the identity where T <= h, keeps every column's order: det of the
+ * map is min(T, h)/T > 0. A buffer node at level rho > 1 (rho^2 =
+ * sum_d (x_d/s_d)^2) goes to t -> sign(t) min(|t|, rho h): the buffer
+ * becomes the shell between the cut ellipse(oid) and its (1 + w)-scaled
+ * copy, as it is for the uncut one. Sets mesh->flatten and recomputes the
+ * Gauss point geometry and mesh->h.
+ *
+ * @return SP_OK; SP_ERR_INPUT when @p mesh is not an ellipse(oid) mesh or
+ *         @p h is not in (0, c)
+ */
+int sp_mesh_flatten(sp_mesh *mesh, double h);
+
+/** @brief Measure of the ellipse (ellipsoid) with semi-axes @p semi cut by
+ *         |x_{dim-1}| <= @p h (h >= the last semi-axis: uncut):
+ *         2D 2 a b (u sqrt(1 - u^2) + asin u), u = h/b; 3D
+ *         pi a b (2 h - 2 h^3 / (3 c^2)). */
+double sp_mesh_flattened_measure(int dim, const double semi[3], double h);
 
 /** @brief The number of nodes sp_mesh_ellipsoid makes, (n+1)^3 + (n + L)(6n^2 + 2)
  *         with n = 2^refinements and L = buffer_layers, without building the mesh. */

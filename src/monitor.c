@@ -147,6 +147,8 @@ int sp_monitor_open(sp_run *run) {
     } else {
       rc = sp_output_open_dim(mon->out_dir, run->mesh->dim, run->lineage.named, &mon->output);
     }
+    if (rc == SP_OK)
+      rc = sp_output_units_write(mon->out_dir, run->mesh->dim, &run->opt.output.units);
     if (rc == SP_OK && run->opt.output.contacts)
       rc = sp_contacts_log_open(mon->out_dir, run->restarted ? run->step : -1,
                                 &mon->contacts_log);

@@ -410,6 +410,56 @@ int sp_output_division(sp_output out, double t, int step, const sp_division_reco
   return sp_log_done(out->divisions, out->divisions_path, n);
 }
 
+/** The columns with a dimension (sp_output_units_write): in which file,
+ *  on which meshes (2, 3; 0: both), and their powers of the model's length
+ *  (dim_power: times the dimension; length_power: plus this) and time. */
+static const struct {
+  const char *file, *column;
+  int only_dim, dim_power, length_power, time_power;
+} sp_unit_columns[] = {
+    {"energy.csv", "t", 0, 0, 0, 1},         {"energy.csv", "dt", 0, 0, 0, 1},
+    {"cells.csv", "t", 0, 0, 0, 1},          {"cells.csv", "mass", 0, 1, 0, 0},
+    {"cells.csv", "xc", 0, 0, 1, 0},         {"cells.csv", "yc", 0, 0, 1, 0},
+    {"cells.csv", "zc", 3, 0, 1, 0},         {"cells.csv", "I1", 0, 1, 2, 0},
+    {"cells.csv", "I2", 0, 1, 2, 0},         {"cells.csv", "I3", 3, 1, 2, 0},
+    {"cells.csv", "core_mass", 0, 1, 0, 0},  {"cells.csv", "area", 2, 1, 0, 0},
+    {"cells.csv", "volume", 3, 1, 0, 0},     {"divisions.csv", "t", 0, 0, 0, 1},
+    {"divisions.csv", "parent_mass_before", 0, 1, 0, 0},
+    {"divisions.csv", "parent_mass_after", 0, 1, 0, 0},
+    {"divisions.csv", "child_mass_after", 0, 1, 0, 0},
+    {"contacts.csv", "t", 0, 0, 0, 1},       {"contacts.csv", "contact", 0, 1, -1, 0},
+    {"contacts.csv", "volume", 0, 1, 0, 0},  {"contacts.csv", "surface", 0, 1, -1, 0},
+    {"contacts.csv", "free_surface", 0, 1, -1, 0}};
+
+int sp_output_units_write(const char *dir, int dim, const sp_output_units *units) {
+  if (!units->length[0] && !units->time[0]) return SP_OK;
+  size_t cap = 4096, used = 0;
+  char *text = malloc(cap);
+  SP_CHECK(text, SP_ERR_MEMORY, "out of memory writing units.csv");
+  used += (size_t)snprintf(text, cap, "file,column,unit,scale\n");
+  for (size_t i = 0; i < sizeof sp_unit_columns / sizeof sp_unit_columns[0]; ++i) {
+    const int only = sp_unit_columns[i].only_dim;
+    const int length = sp_unit_columns[i].dim_power * dim + sp_unit_columns[i].length_power;
+    const int time = sp_unit_columns[i].time_power;
+    if ((only && only != dim) || (length && !units->length[0]) || (time && !units->time[0]))
+      continue;
+    const char *name = length ? units->length : units->time;
+    const int power = length ? length : time;
+    const double scale = pow(length ? units->length_scale : units->time_scale, power);
+    char unit[2 * SP_CELL_NAME_MAX];
+    if (power == 1) snprintf(unit, sizeof unit, "%s", name);
+    else snprintf(unit, sizeof unit, "%s^%d", name, power);
+    used += (size_t)snprintf(text + used, cap - used, "%s,%s,%s,%.17g\n",
+                             sp_unit_columns[i].file, sp_unit_columns[i].column, unit, scale);
+  }
+  char *path = sp_strfmt("%s/units.csv", dir);
+  const int rc = path ? sp_write_file_atomic(path, text, used)
+                      : sp_error_set(SP_ERR_MEMORY, "out of memory naming units.csv");
+  free(path);
+  free(text);
+  return rc;
+}
+
 const char *sp_output_dir(sp_output out) { return out ? out->dir : NULL; }
 
 int sp_output_fields_list(sp_output out, const sp_output_field **fields) {

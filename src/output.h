@@ -166,6 +166,27 @@ const char *sp_output_dir(sp_output out);
 /** @brief Flush and close; *out becomes NULL. */
 int sp_output_close(sp_output *out);
 
+/** The units the outputs may be read in (output.length_unit, ...): one
+ *  model length is length_scale `length`, one model time time_scale
+ *  `time`; an empty name: not given. */
+typedef struct {
+  sp_cell_name length, time;
+  double length_scale, time_scale;
+} sp_output_units;
+
+/**
+ * @brief Write @p dir/units.csv for a run on a mesh of dimension @p dim:
+ *        `file,column,unit,scale`, one row per column of cells.csv,
+ *        divisions.csv, contacts.csv and energy.csv that has a length or
+ *        time dimension (a time, a centre, a mass = area or volume, a
+ *        moment of inertia, a contact or surface), its unit (e.g. um^3) and
+ *        the factor that turns the column's model value into it (e.g.
+ *        length_scale^3). Rows of a dimension whose unit is not given are
+ *        left out; nothing is written when neither is given (the outputs
+ *        are then what they always were).
+ */
+int sp_output_units_write(const char *dir, int dim, const sp_output_units *units);
+
 /** @brief Write @p text to @p path atomically (temporary file + rename). */
 int sp_write_file_atomic(const char *path, const char *text, size_t len);
 

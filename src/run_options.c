@@ -1,6 +1,10 @@
 /* The one reader of the scene for a run (run_options.h). */
 #include "run_options.h"
 
+#include <string.h>
+
+#include "error.h"
+
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
   const sp_scene_mesh *m = &scene->mesh;
   if (m->type == SP_MESH_RECTANGLE)
@@ -8,10 +12,15 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
   if (m->type == SP_MESH_BOX)
     return sp_mesh_box(m->x0, m->y0, m->z0, m->x1, m->y1, m->z1, m->nx, m->ny, m->nz, out);
   if (m->type == SP_MESH_ELLIPSOID)
-    return sp_mesh_ellipsoid(m->refinements, m->semi_x, m->semi_y, m->semi_z, m->buffer_layers,
-                             m->buffer_width, out);
-  return sp_mesh_ellipse(m->refinements, m->semi_x, m->semi_y, m->buffer_layers,
-                         m->buffer_width, out);
+    SP_CALL(sp_mesh_ellipsoid(m->refinements, m->semi_x, m->semi_y, m->semi_z, m->buffer_layers,
+                              m->buffer_width, out));
+  else
+    SP_CALL(sp_mesh_ellipse(m->refinements, m->semi_x, m->semi_y, m->buffer_layers,
+                            m->buffer_width, out));
+  if (!(m->flatten > 0)) return SP_OK;
+  const int rc = sp_mesh_flatten(*out, m->flatten);
+  if (rc != SP_OK) sp_mesh_destroy(out);
+  return rc;
 }
 
 void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt) {
@@ -88,5 +97,9 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
                                 .timings = out->timings,
                                 .checkpoint_every = out->checkpoint_every,
                                 .checkpoint_seconds = out->checkpoint_seconds,
-                                .checkpoint_keep = out->checkpoint_keep};
+                                .checkpoint_keep = out->checkpoint_keep,
+                                .units = {.length_scale = out->length_scale,
+                                          .time_scale = out->time_scale}};
+  memcpy(opt->output.units.length, out->length_unit, sizeof opt->output.units.length);
+  memcpy(opt->output.units.time, out->time_unit, sizeof opt->output.units.time);
 }

@@ -12,6 +12,7 @@
 
 #include "dt_control.h"
 #include "mesh.h"
+#include "output.h"
 #include "scene.h"
 #include "softpack_solver.h"
 #include "time_scheme.h"
@@ -62,6 +63,7 @@ typedef struct {
   int checkpoint_every;
   double checkpoint_seconds;
   int checkpoint_keep;
+  sp_output_units units;   /**< units.csv (output.length_unit, ...) */
 } sp_run_output;
 
 /** Everything a run reads of its scene after set-up. */

@@ -313,6 +313,11 @@ static const sp_key sp_keys[] = {
               AT_MOST(1.0), "-",
               "ellipse, ellipsoid: radial width of the buffer as a fraction of the "
               "semi-axes"),
+    KEY_FLOAT(SP_SEC_MESH, "flatten", mesh.flatten, 0.0, AT_LEAST(0.0), UNBOUNDED, "L",
+              "ellipse, ellipsoid: the coverslip: Omega is the ellipse (ellipsoid) between "
+              "the lines y = -flatten and y = flatten in 2D, the planes z = -flatten and "
+              "z = flatten in 3D (flatten < semi_y, semi_z), its nodes moved onto that cut "
+              "shape (docs/embryo.md, \"The eggshell\"); 0: no cut"),
     /* model */
     KEY_FLOAT(SP_SEC_MODEL, "alpha", model.alpha, 4.0, ABOVE(0.0), UNBOUNDED,
               "E", "double-well height: f(c) = alpha c^2 (c-1)^2"),
@@ -487,6 +492,17 @@ static const sp_key sp_keys[] = {
     KEY_INT(SP_SEC_OUTPUT, "checkpoint_keep", output.checkpoint_keep, 2,
             AT_LEAST(1), AT_MOST(1000000), "files",
             "keep the newest this many checkpoints, delete older ones"),
+    NAME_KEY(SP_SEC_OUTPUT, sp_scene, "length_unit", output.length_unit, 0,
+             "the unit outputs may be read in (e.g. um): units.csv gives each length, area, "
+             "volume, moment, contact and surface column's unit and factor (none: no "
+             "units.csv; docs/embryo.md, \"Units\")"),
+    KEY_FLOAT(SP_SEC_OUTPUT, "length_scale", output.length_scale, 1.0, ABOVE(0.0), UNBOUNDED,
+              "-", "one model length is this many length_unit (e.g. 50: 1 L = 50 um)"),
+    NAME_KEY(SP_SEC_OUTPUT, sp_scene, "time_unit", output.time_unit, 0,
+             "the unit times may be read in (e.g. min): units.csv gives each time column's "
+             "unit and factor"),
+    KEY_FLOAT(SP_SEC_OUTPUT, "time_scale", output.time_scale, 1.0, ABOVE(0.0), UNBOUNDED, "-",
+              "one model time is this many time_unit"),
     /* division */
     KEY_ENUM(SP_SEC_DIVISION, "criterion", division.criterion, SP_DIVIDE_NONE,
              sp_division_words, "-",
@@ -661,7 +677,8 @@ static const sp_key sp_keys[] = {
     LINEAGE_ENUM("axis", axis, SP_AXIS_LONG, sp_axis_words, "-",
                  "the cut's normal: long (the cell's long principal axis, the paper's "
                  "rule), fixed (direction_x, _y, _z) or perpendicular (to the parent's "
-                 "own cut normal: turned by 90 degrees in 2D); long and perpendicular "
+                 "own cut normal: turned by 90 degrees in 2D, in 3D the long axis "
+                 "projected on the plane normal to it); long and perpendicular "
                  "point to +x (then +y, +z), so the first daughter is the one at lower x"),
     LINEAGE_FLOAT("direction_x", direction[0], NAN, UNBOUNDED, UNBOUNDED, "-",
                   "axis fixed: x component of the cut's normal (any length > 0)"),
@@ -1565,6 +1582,34 @@ static int check_ellipsoid_keys(const sp_scene_mesh *m, const char *file) {
   return SP_OK;
 }
 
+/** output.length_scale (time_scale) only with its unit. */
+static int check_unit_keys(const sp_scene *scene, const char *file) {
+  const sp_scene_output *o = &scene->output;
+  SP_CHECK(o->length_unit[0] || o->length_scale == 1.0, SP_ERR_INPUT,
+           "%s: output.length_scale: only with output.length_unit (the unit it counts), got "
+           "%.15g without one", file, o->length_scale);
+  SP_CHECK(o->time_unit[0] || o->time_scale == 1.0, SP_ERR_INPUT,
+           "%s: output.time_scale: only with output.time_unit (the unit it counts), got %.15g "
+           "without one", file, o->time_scale);
+  return SP_OK;
+}
+
+/** mesh.flatten: 0, or on an ellipse (ellipsoid) below its last semi-axis. */
+static int check_flatten_key(const sp_scene *scene, const char *file) {
+  const sp_scene_mesh *m = &scene->mesh;
+  if (m->flatten == 0) return SP_OK;
+  SP_CHECK(m->type == SP_MESH_ELLIPSE || m->type == SP_MESH_ELLIPSOID, SP_ERR_INPUT,
+           "%s: mesh.flatten: only with mesh.type ellipse or ellipsoid, got %.15g with "
+           "mesh.type %s", file, m->flatten, sp_mesh_words[m->type].str);
+  const int dim = sp_scene_dim(scene);
+  const double semi = dim == 3 ? m->semi_z : m->semi_y;
+  SP_CHECK(m->flatten < semi, SP_ERR_INPUT,
+           "%s: mesh.flatten: expected a number < mesh.%s = %.15g (the planes must cut the "
+           "%s; 0: no cut), got %.15g", file, dim == 3 ? "semi_z" : "semi_y", semi,
+           dim == 3 ? "ellipsoid" : "ellipse", m->flatten);
+  return SP_OK;
+}
+
 static int check_time_and_mesh(const sp_scene *scene, const char *file) {
   const sp_scene_time *t = &scene->time;
   SP_CHECK(t->dt_min <= t->dt, SP_ERR_INPUT,
@@ -1603,7 +1648,9 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
              "%s: mesh.z1: expected a number > mesh.z0 = %.15g, got %.15g",
              file, m->z0, m->z1);
   }
-  return check_ellipsoid_keys(&scene->mesh, file);
+  SP_CALL(check_ellipsoid_keys(&scene->mesh, file));
+  SP_CALL(check_unit_keys(scene, file));
+  return check_flatten_key(scene, file);
 }
 
 /** Why a 3D scene cannot have a feature yet (issue 29's later phases). */
@@ -1620,8 +1667,6 @@ static int check_3d(const sp_scene *scene, const char *file) {
              file, scene->shape.delta3);
     return SP_OK;
   }
-  SP_CHECK(scene->n_lineage == 0, SP_ERR_INPUT,
-           "%s: lineage: a lineage table is " SP_NOT_YET_3D ": expected none", file);
   SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
            "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
            ": expected none, got '%s'", file, scene->initial.from);
@@ -1782,6 +1827,21 @@ static int check_disk_in_ellipse(const sp_scene_mesh *m, const sp_scene_cell *c,
   return SP_OK;
 }
 
+/** On a flattened mesh (mesh.flatten), cell @p i's extent along the last
+ *  axis (y in 2D, z in 3D) between the planes. */
+static int check_cell_under_coverslip(const sp_scene_mesh *m, int dim, const sp_scene_cell *c,
+                                      int i, const char *file) {
+  if (!(m->flatten > 0)) return SP_OK;
+  const double centre = dim == 3 ? c->z : c->y, semi = sp_scene_cell_semi_axis(c, dim - 1);
+  const char *axis = dim == 3 ? "z" : "y";
+  SP_CHECK(fabs(centre) + semi <= m->flatten, SP_ERR_INPUT,
+           "%s: cells[%d].%s: the cell reaches %s = %.15g, beyond the plane |%s| = "
+           "mesh.flatten = %.15g (its centre %.15g, its extent %.15g along %s)",
+           file, i, extent_key(c, dim - 1), axis, fabs(centre) + semi, axis, m->flatten,
+           centre, semi, axis);
+  return SP_OK;
+}
+
 /** Every cell's centre, and its whole disk (sphere), inside Omega; z
  *  given exactly on a 3D mesh. */
 static int check_cells(const sp_scene *scene, const char *file) {
@@ -1790,6 +1850,7 @@ static int check_cells(const sp_scene *scene, const char *file) {
     const sp_scene_cell *c = &scene->cells[i];
     if (sp_scene_dim(scene) == 3) {
       SP_CALL(check_sphere(m, c, i, file));
+      SP_CALL(check_cell_under_coverslip(m, 3, c, i, file));
       continue;
     }
     SP_CHECK(isnan(c->z), SP_ERR_INPUT,
@@ -1802,6 +1863,7 @@ static int check_cells(const sp_scene *scene, const char *file) {
              file, i, c->semi_z, sp_mesh_words[m->type].str);
     if (m->type == SP_MESH_RECTANGLE) SP_CALL(check_disk_in_rectangle(m, c, i, file));
     else SP_CALL(check_disk_in_ellipse(m, c, i, file));
+    SP_CALL(check_cell_under_coverslip(m, 2, c, i, file));
   }
   return SP_OK;
 }

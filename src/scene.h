@@ -58,6 +58,8 @@ typedef struct {
                             buffer (0 = none) */
   double buffer_width; /**< ellipse, ellipsoid: buffer width as a fraction
                             of the axes */
+  double flatten;      /**< ellipse, ellipsoid: Omega cut by |y| (2D), |z|
+                            (3D) <= flatten, the coverslip (0: no cut) */
 } sp_scene_mesh;
 
 /** model: the energy and the dynamics (paper table 1). */
@@ -175,6 +177,11 @@ typedef struct {
   int checkpoint_every;      /**< a checkpoint every this many steps (0: off) */
   double checkpoint_seconds; /**< ... and after this much wall time (0: off) */
   int checkpoint_keep;       /**< the newest this many checkpoints are kept */
+  char length_unit[SP_CELL_NAME_MAX]; /**< the unit units.csv reads lengths in
+                                           ("": none) */
+  double length_scale;       /**< one model length is this many length_unit */
+  char time_unit[SP_CELL_NAME_MAX];   /**< ... times in ("": none) */
+  double time_scale;         /**< one model time is this many time_unit */
 } sp_scene_output;
 
 typedef enum {

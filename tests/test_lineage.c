@@ -137,6 +137,31 @@ static void test_normals(void) {
   sp_lineage_normal(&perp, 3, (const double[3]){0, 0, 1}, (const double[3]){0, 0, 1}, n);
   CHECK(fabs(norm3(n) - 1) < 1e-14 && fabs(n[2]) < 1e-14, "3D degenerate: (%g, %g, %g)", n[0],
         n[1], n[2]);
+  /* 3D, generic: the long axis l projected on the plane normal to the
+   * parent's p, normalised, orthogonal to p to 1e-15 even when l is only
+   * 1e-5 rad off p (the second projection); within 1e-6 rad of p the
+   * fallback p x (the axis least along p) */
+  const double p3[3] = {1 / sqrt(14.0), 2 / sqrt(14.0), 3 / sqrt(14.0)};
+  for (int k = 0; k < 3; ++k) {
+    const double off = k == 0 ? 0.7 : k == 1 ? 1e-5 : 1e-7; /* rad */
+    const double q[3] = {2 / sqrt(5.0), -1 / sqrt(5.0), 0}; /* (unit, normal to p3) */
+    double l[3], want[3];
+    for (int d = 0; d < 3; ++d) l[d] = cos(off) * p3[d] + sin(off) * q[d];
+    if (k < 2)
+      memcpy(want, q, sizeof want);
+    else /* p x e_x, e_x being the axis least along p3, normalised */
+      for (int d = 0; d < 3; ++d)
+        want[d] = (double[3]){0, p3[2], -p3[1]}[d] / sqrt(p3[1] * p3[1] + p3[2] * p3[2]);
+    sp_lineage_normal(&perp, 3, l, p3, n);
+    const double along = n[0] * p3[0] + n[1] * p3[1] + n[2] * p3[2];
+    const double miss = fabs(n[0] - want[0]) + fabs(n[1] - want[1]) + fabs(n[2] - want[2]);
+    printf("3D perpendicular, long axis %.1e rad off the parent's normal: (%.15f, %.15f, "
+           "%.15f), n . p = %.2e\n", off, n[0], n[1], n[2], along);
+    CHECK(fabs(along) <= 1e-15 && fabs(norm3(n) - 1) <= 1e-15,
+          "3D perpendicular (%g rad): n . p = %.3g, |n| - 1 = %.3g", off, along, norm3(n) - 1);
+    CHECK(miss <= (k == 1 ? 1e-10 : 1e-14), "3D perpendicular (%g rad): (%.17g, %.17g, %.17g)",
+          off, n[0], n[1], n[2]);
+  }
   /* a zero parent normal (no parent's cut): long */
   sp_lineage_normal(&perp, 2, (const double[3]){0, -1, 0}, zero, n);
   CHECK(n[0] == 0 && n[1] == 1, "perpendicular without a parent: (%g, %g)", n[0], n[1]);

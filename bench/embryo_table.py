@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""The tables of docs/embryo.md ("The C. elegans 8-cell scene") from a run
+of inputs/embryo/celegans_8.yaml or celegans_8_2d.yaml.
+
+usage: bench/embryo_table.py OUT_DIR
+
+Reads OUT_DIR's divisions.csv, cells.csv, contacts.csv and units.csv (the
+units the scene names: um, min) and prints, in Markdown:
+  - every division: its time, the parent and daughters, the table's share
+    and the first daughter's share of the parent's mass right after the cut;
+  - the 4-cell stage (the last step with 4 cells) and the 8-cell stage (the
+    last step): each cell's volume (c >= 1/2; an area in 2D) in the scene's
+    unit and as a fraction of the stage's cells, its mass fraction, and the
+    CShaper atlas's volume and fraction (Cao et al. 2020, as quoted in
+    issue 30);
+  - the contacts of those stages: each pair's contact (contacts.csv) in the
+    scene's unit and as a fraction of each of the two cells' diffuse
+    surfaces.
+"""
+import csv
+import sys
+from collections import defaultdict
+
+ATLAS = {"P0": 20769, "AB": 12304, "P1": 8465, "ABa": 6195, "ABp": 6109, "EMS": 4856,
+         "P2": 3609, "ABal": 2930, "ABar": 3162, "ABpl": 3156, "ABpr": 2857, "MS": 2550,
+         "E": 2249, "C": 2368, "P3": 1157}
+
+
+def read(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def main(out):
+    units = {(r["file"], r["column"]): (r["unit"], float(r["scale"]))
+             for r in read(f"{out}/units.csv")} if _exists(f"{out}/units.csv") else {}
+
+    def conv(file, column, value):
+        unit, scale = units.get((file, column), ("model", 1.0))
+        return value * scale, unit
+
+    divisions = read(f"{out}/divisions.csv")
+    print("| t | parent | first, second | table's share | first daughter's share |")
+    print("|---|---|---|---|---|")
+    for d in divisions:
+        t, unit = conv("divisions.csv", "t", float(d["t"]))
+        share = float(d["parent_mass_after"]) / float(d["parent_mass_before"])
+        print(f"| {t:.2f} {unit} | {d['parent_name']} | {d['first_name']}, {d['second_name']} "
+              f"| {float(d['fraction']):.6f} | {share:.9f} |")
+
+    cells = read(f"{out}/cells.csv")
+    by_step = defaultdict(list)
+    for r in cells:
+        by_step[int(r["step"])].append(r)
+    volume_column = "volume" if "volume" in cells[0] else "area"
+    last = max(by_step)
+    four = max(s for s, rows in by_step.items() if len(rows) == 4)
+    contacts = defaultdict(list)
+    for r in read(f"{out}/contacts.csv"):
+        if int(r["step"]) in (four, last):
+            contacts[int(r["step"])].append(r)
+    for name, step in (("4-cell", four), ("8-cell", last)):
+        rows = by_step[step]
+        t, tunit = conv("cells.csv", "t", float(rows[0]["t"]))
+        total_v = sum(float(r[volume_column]) for r in rows)
+        total_m = sum(float(r["mass"]) for r in rows)
+        total_a = sum(ATLAS[r["name"]] for r in rows)
+        print(f"\n{name} stage (step {step}, t = {t:.2f} {tunit}):\n")
+        print(f"| cell | {volume_column} | fraction | mass fraction | atlas um^3 | atlas fraction |")
+        print("|---|---|---|---|---|---|")
+        for r in sorted(rows, key=lambda r: r["name"]):
+            v, vunit = conv("cells.csv", volume_column, float(r[volume_column]))
+            print(f"| {r['name']} | {v:.1f} {vunit} | {float(r[volume_column]) / total_v:.4f} "
+                  f"| {float(r['mass']) / total_m:.4f} | {ATLAS[r['name']]} "
+                  f"| {ATLAS[r['name']] / total_a:.4f} |")
+        names = {int(r["cell"]): r["name"] for r in rows}
+        surface = {int(r["cell"]): float(r["surface"]) for r in contacts[step]
+                   if int(r["other"]) == 0}
+        print(f"\n| pair | contact | of the first's surface | of the second's |")
+        print("|---|---|---|---|")
+        for r in contacts[step]:
+            k, l = int(r["cell"]), int(r["other"])
+            if l == 0:
+                continue
+            a = float(r["contact"])
+            c, cunit = conv("contacts.csv", "contact", a)
+            print(f"| {names[k]}-{names[l]} | {c:.1f} {cunit} | {a / surface[k]:.3f} "
+                  f"| {a / surface[l]:.3f} |")
+
+
+def _exists(path):
+    try:
+        open(path).close()
+        return True
+    except OSError:
+        return False
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])
