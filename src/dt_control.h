@@ -32,9 +32,12 @@
  *   the two attempts. The next dt comes from a PI
  *   controller, dt_new = dt * safety * err^(-0.7/k) * err_prev^(0.4/k)
  *   (k = the estimate's order + 1), bounded by SP_DT_GROW_MAX and
- *   SP_DT_CUT_MIN and by [dt_min, dt_max]. The first step (and the first
- *   after a division) has no estimate: the caller passes dt_first, chosen
- *   from the state (time_scheme.h: sp_scheme_first_dt).
+ *   SP_DT_CUT_MIN and by [dt_min, dt_max]. The first step has no
+ *   estimate: the caller passes dt_first, chosen from the state
+ *   (time_scheme.h: sp_scheme_first_dt);
+ *   after a division the step restarts from dt_first, at most
+ *   SP_DT_RESTART_FRACTION of the last step, and is estimated (the
+ *   history is split by the cut: time_scheme.h, sp_history_split).
  *
  * Both policies land on events (t_end, output times, age divisions in
  * adaptive mode) without a sliver step: a step that would stop short of an
@@ -59,8 +62,8 @@ typedef enum { SP_DT_ACCEPT = 0, SP_DT_REJECT = 1 } sp_dt_verdict;
 #define SP_DT_CUT_MIN 0.2
 /** Safety factor of the adaptive controller. */
 #define SP_DT_SAFETY 0.9
-/** Adaptive: the first step after a division (no error estimate yet, and
- *  a sharp cut to relax) is at most this fraction of the step before. */
+/** Adaptive: the first step after a division (a sharp cut to relax, which
+ *  the history does not know) is at most this fraction of the step before. */
 #define SP_DT_RESTART_FRACTION 0.1
 /** A step may be stretched by this relative amount to land on an event. */
 #define SP_DT_STRETCH 1e-6

@@ -126,18 +126,43 @@ static int layout_with_child(sp_run *run, int parent, sp_layout **out) {
  *  being its last cell (the division line through the centre, or moved to
  *  halve the mass: division.line; to give the first daughter, the parent's
  *  slot, its share of a lineage entry @p e). */
+/** One division's cut, as a linear map of per-pair values from the run's
+ *  layout to the new one (the state's, and the history's increments). */
+typedef struct {
+  const sp_run *run;
+  int parent;
+  const sp_cell_obs *parent_obs;
+  double offset;
+  const sp_layout *new_layout;
+} split_cut;
+
+static int split_values(void *ctx, const double *values, double *new_values) {
+  const split_cut *cut = ctx;
+  const sp_run_division *dv = &cut->run->opt.division;
+  return sp_division_split(cut->run->mesh, cut->run->layout, values, cut->parent,
+                           cut->parent_obs, dv->smooth_cut, dv->interface_width, cut->offset,
+                           cut->new_layout, new_values, cut->new_layout->n_cells - 1);
+}
+
+/** Split the parent's state (and, under adaptive control, the history's
+ *  past states by the same cut: sp_history_split) onto @p new_layout. */
 static int split_state(sp_run *run, int parent, const sp_cell_obs *parent_obs,
                        const sp_lineage_entry *e, const sp_layout *new_layout,
                        double *new_state) {
   const sp_run_division *dv = &run->opt.division;
-  double offset = 0.0;
+  split_cut cut = {.run = run, .parent = parent, .parent_obs = parent_obs, .offset = 0.0,
+                   .new_layout = new_layout};
   if (e || dv->equal_mass_line)
     SP_CALL(sp_division_balance_offset(run->mesh, run->layout, run->state, parent, parent_obs,
                                        dv->smooth_cut, dv->interface_width,
-                                       e ? 1.0 - e->fraction : 0.5, &offset));
-  return sp_division_split(run->mesh, run->layout, run->state, parent, parent_obs,
-                           dv->smooth_cut, dv->interface_width, offset, new_layout, new_state,
-                           new_layout->n_cells - 1);
+                                       e ? 1.0 - e->fraction : 0.5, &cut.offset));
+  SP_CALL(split_values(&cut, run->state, new_state));
+  if (run->dtc.p.policy != SP_DT_ADAPTIVE) return SP_OK; /* (reset: the paper's restart) */
+  const int rc = sp_history_split(&run->hist, run->mesh, run->layout, run->state, new_layout,
+                                  new_state, parent, new_layout->n_cells - 1, split_values,
+                                  &cut);
+  if (rc != SP_OK) sp_history_reset(&run->hist); /* (the run stops) */
+  return rc;
 }
 
 /**
@@ -168,7 +193,9 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
     sp_layout_destroy(&new_layout);
     return rc;
   }
-  SP_CALL(sp_run_resize(run, new_layout, new_state, SP_HISTORY_RESET));
+  SP_CALL(sp_run_resize(run, new_layout, new_state,
+                        run->dtc.p.policy == SP_DT_ADAPTIVE ? SP_HISTORY_MOVED
+                                                            : SP_HISTORY_RESET));
   sp_registry *cells = &run->cells;
   cells->divided_now[parent] = cells->divided_now[child] = 1;
   cells->source_on[child] = cells->source_on[parent];

@@ -65,7 +65,7 @@ int sp_run_resize(sp_run *run, sp_layout *layout, double *state, sp_history_move
       free(state);
       return rc;
     }
-  } else {
+  } else if (how == SP_HISTORY_RESET) {
     sp_history_reset(&run->hist);
   }
   if (layout != run->layout) sp_layout_destroy(&run->layout);

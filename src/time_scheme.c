@@ -32,9 +32,21 @@ void sp_history_reset(sp_history *h) { /* the layout may change next: no stale s
   sp_history_free(h);
 }
 
-int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
+/** sp_history_transfer's map: (cell, node) values, 0 on new pairs. */
+static int transfer_map(void *ctx, const double *from_values, double *to_values) {
+  const sp_layout *const *layouts = ctx;
+  sp_layout_transfer(layouts[0], from_values, layouts[1], to_values, 0.0);
+  return SP_OK;
+}
+
+/** Move the past states by their increments against the state through
+ *  @p map, each cell's increment shifted to its target mass: the mass it
+ *  had on @p from, except that the divided @p parent's (child >= 0) is
+ *  shared by the daughters in the ratio of their masses in @p state_to. */
+static int history_move(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
                         const double *state_from, const sp_layout *to,
-                        const double *state_to) {
+                        const double *state_to, int parent, int child, sp_history_map map,
+                        void *ctx) {
   const size_t n_from = 2 * (size_t)from->n_pairs, n_to = 2 * (size_t)to->n_pairs;
   const int nc = to->n_cells;
   if (h->n == 0) {
@@ -48,6 +60,15 @@ int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
   double *mass_to = mass_from + nc, *weight = mass_to + nc;
   int rc = sp_cells_pair_weights(mesh, from, w_from);
   if (rc == SP_OK) rc = sp_cells_pair_weights(mesh, to, w_to);
+  double share = 0.0; /* the child's part of the parent's increment mass */
+  if (rc == SP_OK && child >= 0) {
+    double m_parent = 0.0, m_child = 0.0;
+    for (int p = 0; p < to->n_pairs; ++p) {
+      if (to->pair_cell[p] == parent) m_parent += w_to[p] * state_to[2 * p];
+      if (to->pair_cell[p] == child) m_child += w_to[p] * state_to[2 * p];
+    }
+    share = m_parent + m_child != 0.0 ? m_child / (m_parent + m_child) : 0.5;
+  }
   for (int j = 0; j < 2 && rc == SP_OK; ++j) {
     if (j >= h->n) { /* nothing valid to carry: drop the storage */
       free(h->past[j]);
@@ -61,12 +82,20 @@ int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
     }
     double *inc = h->past[j]; /* the increment state - past, in place */
     for (size_t i = 0; i < n_from; ++i) inc[i] = state_from[i] - inc[i];
-    sp_layout_transfer(from, inc, to, past, 0.0);
+    rc = map(ctx, inc, past);
+    if (rc != SP_OK) {
+      free(past);
+      break;
+    }
     /* each cell's increment of c keeps the mass it had (0 when s = 0, so a
      * BDF2 step after the change still conserves mass): the difference
      * spread evenly over the cell's new support */
     for (int k = 0; k < nc; ++k) mass_from[k] = mass_to[k] = weight[k] = 0.0;
     for (int p = 0; p < from->n_pairs; ++p) mass_from[from->pair_cell[p]] += w_from[p] * inc[2 * p];
+    if (child >= 0) {
+      mass_from[child] = share * mass_from[parent];
+      mass_from[parent] -= mass_from[child];
+    }
     for (int p = 0; p < to->n_pairs; ++p) {
       mass_to[to->pair_cell[p]] += w_to[p] * past[2 * p];
       weight[to->pair_cell[p]] += w_to[p];
@@ -80,6 +109,20 @@ int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
   }
   free(w_from);
   return rc;
+}
+
+int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
+                        const double *state_from, const sp_layout *to,
+                        const double *state_to) {
+  const sp_layout *layouts[2] = {from, to};
+  return history_move(h, mesh, from, state_from, to, state_to, -1, -1, transfer_map,
+                      (void *)layouts);
+}
+
+int sp_history_split(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
+                     const double *state_from, const sp_layout *to, const double *state_to,
+                     int parent, int child, sp_history_map split, void *ctx) {
+  return history_move(h, mesh, from, state_from, to, state_to, parent, child, split, ctx);
 }
 
 sp_scheme_kind sp_scheme_of_step(sp_scheme_kind scheme, const sp_history *h) {

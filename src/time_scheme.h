@@ -84,6 +84,25 @@ int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
                         const double *state_from, const sp_layout *to,
                         const double *state_to);
 
+/** A linear map of per-pair values from one layout to another (the
+ *  division's split of the parent: sp_history_split). */
+typedef int (*sp_history_map)(void *ctx, const double *from_values, double *to_values);
+
+/**
+ * @brief Carry the past states through a division: the increments against
+ *        the state are split as the state was (@p split: the same cut, a
+ *        linear map from the old layout to @p to, whose cell @p child is
+ *        new and whose @p parent was the divided cell), then every cell's
+ *        increment is shifted to the mass it had (the parent's shared by
+ *        the daughters in the ratio of their masses in @p state_to; 0 with
+ *        s = 0), as sp_history_transfer does. BDF2 and its error estimate
+ *        go on through the cut instead of starting over: the estimate of
+ *        the first step after it measures the cut's relaxation.
+ */
+int sp_history_split(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
+                     const double *state_from, const sp_layout *to, const double *state_to,
+                     int parent, int child, sp_history_map split, void *ctx);
+
 /** @brief The scheme a step takes: BDF2 needs one past state, else BE. */
 sp_scheme_kind sp_scheme_of_step(sp_scheme_kind scheme, const sp_history *h);
 
