@@ -122,10 +122,6 @@ static int layout_with_child(sp_run *run, int parent, sp_layout **out) {
   return sp_layout_with_child(run->layout, parent, out);
 }
 
-/** The split state of a division of @p parent on @p new_layout, the child
- *  being its last cell (the division line through the centre, or moved to
- *  halve the mass: division.line; to give the first daughter, the parent's
- *  slot, its share of a lineage entry @p e). */
 /** One division's cut, as a linear map of per-pair values from the run's
  *  layout to the new one (the state's, and the history's increments). */
 typedef struct {
@@ -144,8 +140,11 @@ static int split_values(void *ctx, const double *values, double *new_values) {
                            cut->new_layout, new_values, cut->new_layout->n_cells - 1);
 }
 
-/** Split the parent's state (and, under adaptive control, the history's
- *  past states by the same cut: sp_history_split) onto @p new_layout. */
+/** The split state of a division of @p parent on @p new_layout, the child
+ *  being its last cell (the division line through the centre, or moved to
+ *  halve the mass: division.line; to give the first daughter, the parent's
+ *  slot, its share of a lineage entry @p e); under adaptive control the
+ *  history's past states are split by the same cut (sp_history_split). */
 static int split_state(sp_run *run, int parent, const sp_cell_obs *parent_obs,
                        const sp_lineage_entry *e, const sp_layout *new_layout,
                        double *new_state) {
