@@ -72,6 +72,12 @@ class MumpsSolver final : public DirectSolver {
       analysed_ = false;
       set_pattern(A);
       controls();
+      // the values too: the automatic column permutation (ICNTL(6) = 7) and
+      // the scaling read them during the analysis (with the pointer of the
+      // last factorisation they read a matrix of the old pattern, or freed
+      // memory)
+      if (size_ == 1) id_.a = A.val;
+      else id_.a_loc = A.val;
       id_.job = kJobAnalyse;
       dmumps_c(&id_);
       ++symbolic_;
