@@ -86,6 +86,8 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
                                     .interface_width = sp_scene_interface_width(scene)};
   opt->terms = (sp_run_terms){.source_rate = scene->source.rate,
                               .source_off_ratio = scene->source.off_ratio,
+                              .source_extrapolated =
+                                  scene->source.indicator == SP_INDICATOR_EXTRAPOLATED,
                               .shape_delta = {scene->shape.delta1, scene->shape.delta2,
                                               scene->shape.delta3},
                               .shape_implicit = scene->shape.scheme == SP_SHAPE_IMPLICIT,

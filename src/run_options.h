@@ -46,6 +46,8 @@ typedef struct {
 typedef struct {
   double source_rate;      /**< source.rate (0: no source) */
   double source_off_ratio; /**< source.off_ratio */
+  int source_extrapolated; /**< source.indicator extrapolated: BDF2 steps take
+                                omega_k from c extrapolated to t^{n+1} */
   double shape_delta[3];   /**< shape.delta1/2/3 (delta3 0 in 2D) */
   int shape_implicit;      /**< shape.scheme: implicit */
   int shrink_always;       /**< layout.shrink: always */

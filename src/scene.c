@@ -197,6 +197,8 @@ static const cyaml_strval_t sp_fill_words[] = {{"edge", SP_FILL_EDGE},
                                                   {"relax", SP_FILL_RELAX}};
 static const cyaml_strval_t sp_axis_words[] = {
     {"long", SP_AXIS_LONG}, {"fixed", SP_AXIS_FIXED}, {"perpendicular", SP_AXIS_PERPENDICULAR}};
+static const cyaml_strval_t sp_indicator_words[] = {
+    {"extrapolated", SP_INDICATOR_EXTRAPOLATED}, {"previous", SP_INDICATOR_PREVIOUS}};
 static const cyaml_strval_t sp_support_words[] = {
     {"auto", SP_SUPPORT_AUTO}, {"full", SP_SUPPORT_FULL}, {"local", SP_SUPPORT_LOCAL}};
 /* The YAML 1.1 booleans; the first word of each value is the one printed. */
@@ -546,6 +548,11 @@ static const sp_key sp_keys[] = {
     KEY_FLOAT(SP_SEC_SOURCE, "off_ratio", source.off_ratio, 1.1, ABOVE(1.0),
               UNBOUNDED, "-",
               "a cell's source stops once N >= N_max and m_k / m_k^0 > this"),
+    KEY_ENUM(SP_SEC_SOURCE, "indicator", source.indicator, SP_INDICATOR_EXTRAPOLATED,
+             sp_indicator_words, "-",
+             "where a BDF2 step evaluates omega_k (c_k >= 1/2): c extrapolated "
+             "linearly to the step's end (second order) or c^n (first order); "
+             "backward-Euler steps use c^n (the paper's algorithm 3)"),
     /* layout */
     KEY_ENUM(SP_SEC_LAYOUT, "support", layout.support, SP_SUPPORT_AUTO,
              sp_support_words, "-",

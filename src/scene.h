@@ -209,10 +209,14 @@ typedef struct {
                                  inertia and the mass criterion */
 } sp_scene_division;
 
+/** Where a BDF2 step evaluates the source's indicator c_k >= 1/2. */
+typedef enum { SP_INDICATOR_EXTRAPOLATED = 0, SP_INDICATOR_PREVIOUS = 1 } sp_indicator_kind;
+
 /** source: the adaptive growth source (paper algorithm 3). */
 typedef struct {
   double rate;      /**< s_bar inside each cell (0: no source) */
   double off_ratio; /**< switch off once N >= N_max and m/m0 > this */
+  sp_indicator_kind indicator; /**< BDF2 steps: c extrapolated to t^{n+1}, or c^n */
 } sp_scene_source;
 
 typedef enum { SP_SUPPORT_AUTO = 0, SP_SUPPORT_FULL = 1, SP_SUPPORT_LOCAL = 2 } sp_support_kind;
