@@ -17,10 +17,11 @@
 #   NP=2 bench/aggregate.sh         (under mpirun -np 2)
 #   OUT=dir IMG=dir bench/aggregate.sh --reuse   (another run's outputs, pictures elsewhere)
 #   SOFTPACK=path bench/aggregate.sh              (another binary, e.g. a copy)
+#   SCENE=inputs/aggregate_256_defaults.yaml bench/aggregate.sh  (the scene with the defaults)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . bench/lib.sh
-scene=inputs/aggregate_256.yaml
+scene=${SCENE:-inputs/aggregate_256.yaml}
 out=${OUT:-out/aggregate_256}
 img=${IMG:-docs/img/aggregate_256}
 export OMP_NUM_THREADS=1
