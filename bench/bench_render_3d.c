@@ -20,8 +20,8 @@
 
 #define N_CELLS 8
 
-typedef int (*render_fn)(const sp_mesh *, const sp_layout *, const double *, double, int,
-                         const char *);
+typedef int (*render_fn)(const sp_mesh *, const sp_layout *, const double *, double,
+                         const sp_cell_name *, int, const char *);
 
 static void time_picture(const char *what, render_fn fn, const sp_mesh *m, const sp_layout *l,
                          const double *state, int width, const char *dir) {
@@ -30,7 +30,7 @@ static void time_picture(const char *what, render_fn fn, const sp_mesh *m, const
   double best = HUGE_VAL;
   for (int rep = 0; rep < 3; ++rep) {
     const double t0 = sp_wall_clock();
-    if (fn(m, l, state, 0.0, width, path) != SP_OK) {
+    if (fn(m, l, state, 0.0, NULL, width, path) != SP_OK) {
       fprintf(stderr, "%s: %s\n", what, sp_error_message());
       exit(1);
     }

@@ -15,7 +15,12 @@ units the scene names: um, min) and prints, in Markdown:
     issue 30);
   - the contacts of those stages: each pair's contact (contacts.csv) in the
     scene's unit and as a fraction of each of the two cells' diffuse
-    surfaces.
+    surfaces, beside the published ones: PUBLISHED holds the contact
+    fractions that can be cited (none found: docs/embryo.md, "Contacts
+    against the atlas", says what was searched; the column prints "-"),
+    and TOUCHES whether the pair touches in the embryo where a source says
+    so (the 4-cell "diamond": ABa does not touch P2, the other five pairs
+    do; Giammona and Campas 2021, PLoS Comput Biol 17:e1007994, Fig 1A).
 """
 import csv
 import sys
@@ -24,6 +29,16 @@ from collections import defaultdict
 ATLAS = {"P0": 20769, "AB": 12304, "P1": 8465, "ABa": 6195, "ABp": 6109, "EMS": 4856,
          "P2": 3609, "ABal": 2930, "ABar": 3162, "ABpl": 3156, "ABpr": 2857, "MS": 2550,
          "E": 2249, "C": 2368, "P3": 1157}
+
+# Published contact fractions by pair (frozenset of names): none could be
+# cited (docs/embryo.md, "Contacts against the atlas").
+PUBLISHED = {}
+
+# Whether a pair touches in the embryo, where a source says so: the 4-cell
+# stage's diamond (Giammona and Campas 2021, Fig 1A).
+TOUCHES = {frozenset(p): "yes" for p in (("ABa", "ABp"), ("ABa", "EMS"), ("ABp", "EMS"),
+                                          ("ABp", "P2"), ("EMS", "P2"))}
+TOUCHES[frozenset(("ABa", "P2"))] = "no"
 
 
 def read(path):
@@ -76,16 +91,20 @@ def main(out):
         names = {int(r["cell"]): r["name"] for r in rows}
         surface = {int(r["cell"]): float(r["surface"]) for r in contacts[step]
                    if int(r["other"]) == 0}
-        print(f"\n| pair | contact | of the first's surface | of the second's |")
-        print("|---|---|---|---|")
+        print("\n| pair | contact | of the first's surface | of the second's "
+              "| published | touches in the embryo |")
+        print("|---|---|---|---|---|---|")
         for r in contacts[step]:
             k, l = int(r["cell"]), int(r["other"])
             if l == 0:
                 continue
             a = float(r["contact"])
             c, cunit = conv("contacts.csv", "contact", a)
+            pair = frozenset((names[k], names[l]))
+            published = PUBLISHED.get(pair)
             print(f"| {names[k]}-{names[l]} | {c:.1f} {cunit} | {a / surface[k]:.3f} "
-                  f"| {a / surface[l]:.3f} |")
+                  f"| {a / surface[l]:.3f} | {'-' if published is None else published} "
+                  f"| {TOUCHES.get(pair, '-')} |")
 
 
 def _exists(path):

@@ -147,6 +147,17 @@ int sp_layout_pair(const sp_layout *l, int cell, int node) {
   return -1;
 }
 
+int sp_layout_node_cell(const sp_layout *l, const double *state, int node) {
+  int cell = -1;
+  double best = 0.5;
+  for (int p = l->node_start[node]; p < l->node_start[node + 1]; ++p)
+    if (state[2 * p] > best) { /* strict: ties keep the lower cell */
+      best = state[2 * p];
+      cell = l->pair_cell[p];
+    }
+  return cell;
+}
+
 void sp_layout_transfer(const sp_layout *from, const double *state_from,
                         const sp_layout *to, double *state_to, double fill_c) {
   for (int i = 0; i < to->n_nodes; ++i)

@@ -133,6 +133,11 @@ int sp_layout_cells(const sp_layout *layout, const sp_cell_pairs **out);
 /** @brief The pair of (cell, node), or -1 if node is outside the support. */
 int sp_layout_pair(const sp_layout *layout, int cell, int node);
 
+/** @brief The cell at @p node of @p state: the one (from 0) with the largest
+ *         c > 1/2 there (ties keep the lower), or -1 where none has c > 1/2
+ *         (the .vtu's cell_id minus 1; the pictures' name labels). */
+int sp_layout_node_cell(const sp_layout *layout, const double *state, int node);
+
 /** @brief Copy values from one layout's state to another's by (cell, node);
  *         pairs absent from @p from get c = fill_c, mu = 0. */
 void sp_layout_transfer(const sp_layout *from, const double *state_from,

@@ -80,6 +80,12 @@ static int record_energy(sp_run *run, double dt, int its, const sp_step_costs *c
                                run->cells.obs, run->opt.output.contact_threshold);
 }
 
+/** The cells' names for the fields and pictures: a named scene's, else
+ *  NULL (its outputs as they were before names). */
+static const sp_cell_name *cell_names(const sp_run *run) {
+  return run->lineage.named ? (const sp_cell_name *)run->cells.name : NULL;
+}
+
 /** The fields of the state: a piece per rank and the .pvtu by rank 0 under
  *  MPI, else one .vtu. */
 static int write_fields(sp_run *run) {
@@ -89,14 +95,15 @@ static int write_fields(sp_run *run) {
     SP_ALLOC(first_node, (size_t)run->n_ranks + 1);
     sp_partition_ranges(run->layout, run->n_ranks, first_node);
     const int rc = sp_output_fields_piece(mon->out_dir, run->mesh, run->layout, run->state,
-                                          run->step, run->t, run->rank,
+                                          run->step, run->t, cell_names(run), run->rank,
                                           first_node[run->rank], first_node[run->rank + 1]);
     free(first_node);
     SP_CALL(rc);
     if (run->rank != 0) return SP_OK;
     return sp_output_fields_pvtu(mon->output, run->layout, run->step, run->t, run->n_ranks);
   }
-  return sp_output_fields(mon->output, run->mesh, run->layout, run->state, run->step, run->t);
+  return sp_output_fields(mon->output, run->mesh, run->layout, run->state, run->step, run->t,
+                          cell_names(run));
 }
 
 /** The pictures of the state (output.pictures; rank 0): in 2D
@@ -109,12 +116,15 @@ static int write_pictures(sp_run *run) {
   char path[4096];
   if (run->mesh->dim == 3) {
     snprintf(path, sizeof path, "%s/sections_%06d.png", dir, run->step);
-    SP_CALL(sp_render_sections(run->mesh, run->layout, run->state, run->t, width, path));
+    SP_CALL(sp_render_sections(run->mesh, run->layout, run->state, run->t, cell_names(run), width,
+                               path));
     snprintf(path, sizeof path, "%s/surfaces_%06d.png", dir, run->step);
-    SP_CALL(sp_render_surfaces(run->mesh, run->layout, run->state, run->t, width, path));
+    SP_CALL(sp_render_surfaces(run->mesh, run->layout, run->state, run->t, cell_names(run), width,
+                               path));
   } else {
     snprintf(path, sizeof path, "%s/cells_%06d.png", dir, run->step);
-    SP_CALL(sp_render_cells(run->mesh, run->layout, run->state, run->t, width, path));
+    SP_CALL(sp_render_cells(run->mesh, run->layout, run->state, run->t, cell_names(run), width,
+                            path));
   }
   if (!run->opt.output.contacts) return SP_OK;
   snprintf(path, sizeof path, "%s/contacts_%06d.png", dir, run->step);

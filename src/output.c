@@ -567,19 +567,6 @@ static void sp_vtu_array_open(FILE *f, const char *type, const char *name,
 
 static void sp_vtu_array_close(FILE *f) { fprintf(f, "\n        </DataArray>\n"); }
 
-/** cell_id of node i: the k (1-based) of the largest c_k > 1/2, else 0. */
-static int32_t sp_node_cell_id(const sp_layout *l, const double *state,
-                               int i) {
-  int32_t id = 0;
-  double best = 0.5;
-  for (int p = l->node_start[i]; p < l->node_start[i + 1]; ++p)
-    if (state[2 * p] > best) { /* strict: ties keep the lower k */
-      best = state[2 * p];
-      id = l->pair_cell[p] + 1;
-    }
-  return id;
-}
-
 /** VTK's cell types (vtkCellType.h). */
 enum { SP_VTK_QUAD = 9, SP_VTK_HEXAHEDRON = 12 };
 
@@ -595,9 +582,25 @@ typedef struct {
 static int part_node(const sp_vtu_part *p, int j) { return p->node ? p->node[j] : j; }
 static int part_elem(const sp_vtu_part *p, int j) { return p->elem ? p->elem[j] : j; }
 
-/** Write a .vtu to @p f (errors are left in ferror(f)). */
-static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
-                         const double *state, int step, double t, const sp_vtu_part *part) {
+/** The cells' names in a .vtu's FieldData: the String array cell_name, one
+ *  tuple per cell (tuple k - 1 names c_k and cell_id k), in VTK's ASCII
+ *  form for strings (vtkXMLWriter's): each character as its code, each
+ *  string ended by a 0. */
+static void sp_vtu_names(FILE *f, int n_cells, const sp_cell_name *names) {
+  fprintf(f, "      <DataArray type=\"String\" Name=\"cell_name\" NumberOfTuples=\"%d\" "
+             "format=\"ascii\">",
+          n_cells);
+  for (int k = 0; k < n_cells; ++k) {
+    for (const unsigned char *c = (const unsigned char *)names[k]; *c; ++c) fprintf(f, "%d ", *c);
+    fprintf(f, k + 1 < n_cells ? "0 " : "0");
+  }
+  fprintf(f, "</DataArray>\n");
+}
+
+/** Write a .vtu to @p f (errors are left in ferror(f)); @p names (NULL:
+ *  none) adds the cell_name array. */
+static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l, const double *state,
+                         int step, double t, const sp_cell_name *names, const sp_vtu_part *part) {
   const int nn = part->n_nodes, ne = part->n_elems;
   const uint16_t probe = 1;
   const int little = *(const unsigned char *)&probe == 1;
@@ -613,9 +616,10 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
              "      <DataArray type=\"Float64\" Name=\"TIME\" "
              "NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n"
              "      <DataArray type=\"Int32\" Name=\"CYCLE\" "
-             "NumberOfTuples=\"1\" format=\"ascii\">%d</DataArray>\n"
-             "    </FieldData>\n",
+             "NumberOfTuples=\"1\" format=\"ascii\">%d</DataArray>\n",
           t, step);
+  if (names) sp_vtu_names(f, l->n_cells, names);
+  fprintf(f, "    </FieldData>\n");
   fprintf(f, "    <Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\">\n", nn,
           ne);
 
@@ -639,7 +643,8 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
   sp_vtu_array_open(f, "Int32", "cell_id", 1);
   sp_b64_begin_array(&b, f, (uint64_t)nn * sizeof(int32_t));
   for (int j = 0; j < nn; ++j) {
-    int32_t id = sp_node_cell_id(l, state, part_node(part, j));
+    /* the k (1-based) of the largest c_k > 1/2, else 0 */
+    int32_t id = sp_layout_node_cell(l, state, part_node(part, j)) + 1;
     sp_b64_put(&b, &id, sizeof id);
   }
   sp_b64_end(&b);
@@ -761,7 +766,7 @@ static int sp_fields_record(struct sp_output_s *o, int step, double t, int pvtu)
 
 int sp_output_fields(sp_output out, const sp_mesh *mesh,
                      const sp_layout *layout, const double *state, int step,
-                     double t) {
+                     double t, const sp_cell_name *names) {
   SP_CHECK(mesh->n_nodes == layout->n_nodes, SP_ERR_INTERNAL,
            "output: mesh has %d nodes but layout has %d", mesh->n_nodes,
            layout->n_nodes);
@@ -774,7 +779,7 @@ int sp_output_fields(sp_output out, const sp_mesh *mesh,
   int rc = sp_tmp_open(path, &tmp, &f);
   if (rc == SP_OK) {
     const sp_vtu_part all = {mesh->n_nodes, mesh->n_elems, NULL, NULL, NULL};
-    sp_vtu_write(f, mesh, layout, state, step, t, &all);
+    sp_vtu_write(f, mesh, layout, state, step, t, names, &all);
     rc = sp_tmp_commit(path, tmp, f);
   }
   free(path);
@@ -784,8 +789,8 @@ int sp_output_fields(sp_output out, const sp_mesh *mesh,
 }
 
 int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout *layout,
-                           const double *state, int step, double t, int rank,
-                           int first_node, int end_node) {
+                           const double *state, int step, double t, const sp_cell_name *names,
+                           int rank, int first_node, int end_node) {
   SP_CHECK(mesh->n_nodes == layout->n_nodes && first_node >= 0 && first_node <= end_node &&
            end_node <= mesh->n_nodes && step >= 0 && rank >= 0, SP_ERR_INTERNAL,
            "output piece: nodes %d..%d of %d (layout %d), step %d, rank %d", first_node,
@@ -815,7 +820,7 @@ int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout
   int rc = path ? sp_tmp_open(path, &tmp, &f)
                 : sp_error_set(SP_ERR_MEMORY, "out of memory naming a .vtu in '%s'", dir);
   if (rc == SP_OK) {
-    sp_vtu_write(f, mesh, layout, state, step, t, &part);
+    sp_vtu_write(f, mesh, layout, state, step, t, names, &part);
     rc = sp_tmp_commit(path, tmp, f);
   }
   free(path);

@@ -111,21 +111,25 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
  *        c_k and mu_k per cell, 0 outside a cell's support, and cell_id = the
  *        k (from 1) with the largest c_k where that c_k > 1/2, else 0) and
  *        rewrite fields.pvd listing every .vtu written so far with its time.
+ *        With @p names (a named scene's; NULL: none) its FieldData holds
+ *        the String array cell_name, one name per cell, cell k's at tuple
+ *        k - 1 (docs/embryo.md, "Names in the fields and the pictures").
  */
 int sp_output_fields(sp_output out, const sp_mesh *mesh,
                      const sp_layout *layout, const double *state, int step,
-                     double t);
+                     double t, const sp_cell_name *names);
 
 /**
  * @brief MPI runs: write this rank's piece fields_<step>_p<rank>.vtu: the
  *        elements whose first node is in [first_node, end_node) (the rule
  *        by which the solver's ranks assemble) and the nodes they use, with
- *        the arrays of sp_output_fields plus node_id (the global node). Any
- *        rank may call it; it needs only the output directory.
+ *        the arrays of sp_output_fields (and cell_name with @p names) plus
+ *        node_id (the global node). Any rank may call it; it needs only the
+ *        output directory.
  */
 int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout *layout,
-                           const double *state, int step, double t, int rank,
-                           int first_node, int end_node);
+                           const double *state, int step, double t, const sp_cell_name *names,
+                           int rank, int first_node, int end_node);
 
 /**
  * @brief MPI runs, rank 0: write fields_<step>.pvtu naming the pieces of

@@ -144,6 +144,43 @@ static void sp_pixel_out(double u, double v, int h, double *px, double *py, int 
   if (height_px) *height_px = h;
 }
 
+/** Cell k's label (from 0): its name, or its number (from 1, as in
+ *  cells.csv) for an unnamed cell of a named scene. */
+static const char *sp_cell_label(const sp_cell_name *names, int k, char buf[16]) {
+  if (names[k][0]) return names[k];
+  snprintf(buf, 16, "%d", k + 1);
+  return buf;
+}
+
+/** @p text in bold centred on the pixel (x, y): black letters on a white
+ *  halo, readable on any colour of the map. */
+static void sp_name_label(cairo_t *cr, double x, double y, double font, const char *text) {
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  cairo_set_font_size(cr, font);
+  cairo_text_extents_t ext;
+  cairo_text_extents(cr, text, &ext);
+  cairo_move_to(cr, x - 0.5 * ext.width - ext.x_bearing, y - 0.5 * ext.height - ext.y_bearing);
+  cairo_text_path(cr, text);
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  cairo_set_line_width(cr, 0.25 * font);
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_stroke_preserve(cr);
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_fill(cr);
+}
+
+/** Label each cell k with sum[3 k + 2] > @p min_count at its mean pixel
+ *  (sum[3 k] / n, sum[3 k + 1] / n, n = sum[3 k + 2]). */
+static void sp_name_labels(cairo_t *cr, int n_cells, const double *sum, double min_count,
+                           double font, const sp_cell_name *names) {
+  for (int k = 0; k < n_cells; ++k) {
+    const double n = sum[3 * k + 2];
+    char buf[16];
+    if (n > min_count)
+      sp_name_label(cr, sum[3 * k] / n, sum[3 * k + 1] / n, font, sp_cell_label(names, k, buf));
+  }
+}
+
 /* ------------------------------------------------------------------------ */
 /* Cells picture                                                            */
 /* ------------------------------------------------------------------------ */
@@ -379,7 +416,7 @@ static int sp_phi_nodes(const sp_mesh *m, const sp_layout *l, const double *stat
 /** Everything drawn on an existing white RGB24 surface. */
 static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
                          const sp_mesh *m, const sp_layout *l,
-                         const double *state, double t) {
+                         const double *state, double t, const sp_cell_name *names) {
   /* phi at the nodes: the max over the cells supported there. */
   double *phi;
   SP_CALL(sp_phi_nodes(m, l, state, &phi));
@@ -433,12 +470,26 @@ static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
   }
 
   rc = sp_outline_and_time(cr, m, fr, lw, t, "cells");
+  if (rc == SP_OK && names) { /* each name at the mean of its cell's nodes */
+    double *sum = calloc(3 * (size_t)l->n_cells + 1, sizeof *sum);
+    if (!sum) rc = sp_error_set(SP_ERR_MEMORY, "out of memory labelling the cells");
+    for (int i = 0; rc == SP_OK && i < m->n_nodes; ++i) {
+      const int k = sp_layout_node_cell(l, state, i);
+      if (k < 0) continue;
+      double px, py;
+      sp_frame_map(fr, m->xy[2 * i], m->xy[2 * i + 1], &px, &py);
+      sum[3 * k] += px, sum[3 * k + 1] += py, sum[3 * k + 2] += 1;
+    }
+    if (rc == SP_OK) sp_name_labels(cr, l->n_cells, sum, 0, fr->font, names);
+    free(sum);
+    if (rc == SP_OK) rc = sp_cairo_check(cairo_status(cr), "drawing", "cells");
+  }
   cairo_destroy(cr);
   return rc;
 }
 
 int sp_render_cells(const sp_mesh *mesh, const sp_layout *layout,
-                    const double *state, double t, int width_px,
+                    const double *state, double t, const sp_cell_name *names, int width_px,
                     const char *path) {
   SP_CHECK(mesh->dim == 2, SP_ERR_INTERNAL,
            "render: the cells picture is 2D (a 3D state has sp_render_sections and "
@@ -449,7 +500,7 @@ int sp_render_cells(const sp_mesh *mesh, const sp_layout *layout,
   /* White first: whatever the mesh does not cover stays white. */
   cairo_surface_t *surf = NULL;
   int rc = sp_white_surface(fr.w, fr.h, path, &surf);
-  if (rc == SP_OK) rc = sp_draw_cells(surf, &fr, mesh, layout, state, t);
+  if (rc == SP_OK) rc = sp_draw_cells(surf, &fr, mesh, layout, state, t, names);
   if (rc == SP_OK) rc = sp_png_write(surf, path);
   if (surf) cairo_surface_destroy(surf);
   return rc;
@@ -914,14 +965,37 @@ static int sp_hex_locate(const double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], const 
   return fabs(xi[0]) <= 1 + 1e-9 && fabs(xi[1]) <= 1 + 1e-9 && fabs(xi[2]) <= 1 + 1e-9;
 }
 
+/** The cell (from 0) with the largest c > 1/2 at a point of the hexahedron
+ *  with nodes @p en and shape function values @p N (each c_k interpolated
+ *  trilinearly, 0 off its support), or -1. */
+static int sp_section_cell(const sp_layout *l, const double *state, const int *en,
+                           const double N[SP_Q1_MAX_NODES]) {
+  enum { MAX = 64 }; /* the distinct cells at 8 nodes: more are not labelled */
+  int cell[MAX], n = 0, best = -1;
+  double c[MAX], top = 0.5;
+  for (int a = 0; a < 8; ++a)
+    for (int p = l->node_start[en[a]]; p < l->node_start[en[a] + 1]; ++p) {
+      int i = 0;
+      while (i < n && cell[i] != l->pair_cell[p]) ++i;
+      if (i == n && n == MAX) continue;
+      if (i == n) cell[n] = l->pair_cell[p], c[n++] = 0;
+      c[i] += N[a] * state[2 * p];
+    }
+  for (int i = 0; i < n; ++i) /* equal values keep the lower cell, as cell_id's */
+    if (c[i] > top || (c[i] == top && best >= 0 && cell[i] < best)) top = c[i], best = cell[i];
+  return best;
+}
+
 /**
  * Colour the pixels of panel @p a that lie in the plane's section of each
  * element with jet(phi), phi interpolated trilinearly at the pixel centre
  * (the element walked, its slice rasterised over its bounding box's
- * pixels); buffer elements washed out as in 2D.
+ * pixels); buffer elements washed out as in 2D. With @p sum (names), add
+ * each pixel to its cell's sums (sp_name_labels).
  */
 static void sp_section_fill(uint32_t *data, int stride, const sp_sections_frame *fr, int a,
-                            const sp_mesh *m, const double *phi) {
+                            const sp_mesh *m, const double *phi, const sp_layout *l,
+                            const double *state, double *sum) {
   const int hx = sp_section_axes[a][0], vx = sp_section_axes[a][1];
   const double x0 = fr->left[a], x1 = x0 + (fr->hi[hx] - fr->lo[hx]) * fr->s;
   const double y0 = fr->top, y1 = y0 + (fr->hi[vx] - fr->lo[vx]) * fr->s;
@@ -950,6 +1024,10 @@ static void sp_section_fill(uint32_t *data, int stride, const sp_sections_frame 
         double N[SP_Q1_MAX_NODES], dN[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], v = 0;
         sp_q1_shape(3, xi, N, dN);
         for (int n = 0; n < 8; ++n) v += N[n] * phi[m->elem[8 * (size_t)e + n]];
+        if (sum) { /* names: the pixel's cell, as the .vtu's cell_id */
+          const int k = sp_section_cell(l, state, m->elem + 8 * (size_t)e, N);
+          if (k >= 0) sum[3 * k] += i + 0.5, sum[3 * k + 1] += j + 0.5, sum[3 * k + 2] += 1;
+        }
         double rgb[3];
         sp_jet(v, rgb);
         if (lighten)
@@ -1007,22 +1085,35 @@ static int sp_sections_labels(cairo_surface_t *surf, const sp_sections_frame *fr
 }
 
 int sp_render_sections(const sp_mesh *mesh, const sp_layout *layout, const double *state,
-                       double t, int width_px, const char *path) {
+                       double t, const sp_cell_name *names, int width_px, const char *path) {
   SP_CALL(sp_layout_check(mesh, layout));
   sp_sections_frame fr = {0};
   SP_CALL(sp_sections_frame_make(mesh, width_px, &fr));
-  double *phi;
+  double *phi, *sum = NULL; /* names: each cell's pixel sums, per panel */
   SP_CALL(sp_phi_nodes(mesh, layout, state, &phi));
   cairo_surface_t *surf = NULL;
   int rc = sp_white_surface(fr.w, fr.h, path, &surf);
+  if (rc == SP_OK && names && !(sum = calloc(9 * (size_t)layout->n_cells + 1, sizeof *sum)))
+    rc = sp_error_set(SP_ERR_MEMORY, "out of memory labelling the cells");
   if (rc == SP_OK) {
     cairo_surface_flush(surf);
     uint32_t *data = (uint32_t *)cairo_image_surface_get_data(surf);
     const int stride = cairo_image_surface_get_stride(surf) / 4;
-    for (int a = 0; a < 3; ++a) sp_section_fill(data, stride, &fr, a, mesh, phi);
+    for (int a = 0; a < 3; ++a)
+      sp_section_fill(data, stride, &fr, a, mesh, phi, layout, state,
+                      sum ? sum + 3 * (size_t)a * layout->n_cells : NULL);
     cairo_surface_mark_dirty(surf);
     rc = sp_sections_labels(surf, &fr, t);
   }
+  if (rc == SP_OK && sum) { /* a name where its cell's section is at least a label's height */
+    cairo_t *cr = cairo_create(surf);
+    for (int a = 0; a < 3; ++a)
+      sp_name_labels(cr, layout->n_cells, sum + 3 * (size_t)a * layout->n_cells,
+                     fr.font * fr.font, fr.font, names);
+    rc = sp_cairo_check(cairo_status(cr), "drawing", "sections");
+    cairo_destroy(cr);
+  }
+  free(sum);
   free(phi);
   if (rc == SP_OK) rc = sp_png_write(surf, path);
   cairo_surface_destroy(surf);
@@ -1314,16 +1405,62 @@ static void sp_axes_triad(cairo_t *cr, const sp_camera *cam) {
   }
 }
 
+/** The legend of a named scene's 3D view: each cell's colour (a square)
+ *  and name, in rows across the picture, in a strip below the view. Lays
+ *  the items out from the top of the strip @p y0 and returns the strip's
+ *  height; draws them only if @p draw. */
+static double sp_legend(cairo_t *cr, const sp_camera *cam, int n_cells, const sp_cell_name *names,
+                        double y0, int draw) {
+  const double font = cam->font, row = 1.5 * font, margin = cam->w / 50.0;
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, font);
+  double x = margin, y = y0 + 0.5 * font;
+  for (int k = 0; k < n_cells; ++k) {
+    char buf[16];
+    const char *text = sp_cell_label(names, k, buf);
+    cairo_text_extents_t ext;
+    cairo_text_extents(cr, text, &ext);
+    const double item = 0.8 * font + 0.4 * font + ext.x_advance;
+    if (x > margin && x + item > cam->w - margin) x = margin, y += row; /* next row */
+    if (draw) {
+      const double *rgb = sp_cell_palette[k % 10];
+      cairo_set_source_rgb(cr, rgb[0], rgb[1], rgb[2]);
+      cairo_rectangle(cr, round(x), round(y + 0.2 * font), round(0.8 * font), round(0.8 * font));
+      cairo_fill(cr);
+      cairo_set_source_rgb(cr, 0, 0, 0);
+      cairo_move_to(cr, x + 1.2 * font, y + font);
+      cairo_show_text(cr, text);
+    }
+    x += item + 1.2 * font;
+  }
+  return ceil(y + row + margin - y0);
+}
+
 static int sp_draw_surfaces(cairo_surface_t *surf, const sp_camera *cam, sp_faces2d fs[3],
-                            double t) {
+                            double t, int n_cells, const sp_cell_name *names) {
   cairo_t *cr = cairo_create(surf);
   sp_faces2d_fill(cr, &fs[0], 0.3);  /* the far side of the eggshell */
   sp_faces2d_fill(cr, &fs[1], 1.0);  /* the cells, far to near */
   sp_faces2d_fill(cr, &fs[2], 0.12); /* the near side, over them */
   sp_axes_triad(cr, cam);
   sp_time_label(cr, cam->w / 50.0, 1.3 * cam->font, cam->font, t);
+  if (names) sp_legend(cr, cam, n_cells, names, cam->h, 1);
   const int rc = sp_cairo_check(cairo_status(cr), "drawing", "surfaces");
   cairo_destroy(cr);
+  return rc;
+}
+
+/** The height of the 3D view's legend strip (0 without names). */
+static int sp_legend_height(const sp_camera *cam, int n_cells, const sp_cell_name *names,
+                            const char *path, int *height) {
+  *height = 0;
+  if (!names) return SP_OK;
+  cairo_surface_t *scratch = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 1, 1);
+  cairo_t *cr = cairo_create(scratch);
+  *height = (int)sp_legend(cr, cam, n_cells, names, 0, 0);
+  const int rc = sp_cairo_check(cairo_status(cr), "measuring the legend", path);
+  cairo_destroy(cr);
+  cairo_surface_destroy(scratch);
   return rc;
 }
 
@@ -1338,7 +1475,7 @@ int sp_render_surfaces_pixel(const sp_mesh *mesh, int width_px, const double *x,
 }
 
 int sp_render_surfaces(const sp_mesh *mesh, const sp_layout *layout, const double *state,
-                       double t, int width_px, const char *path) {
+                       double t, const sp_cell_name *names, int width_px, const char *path) {
   SP_CALL(sp_layout_check(mesh, layout));
   sp_camera cam = {0};
   SP_CALL(sp_camera_make(mesh, width_px, &cam));
@@ -1349,9 +1486,11 @@ int sp_render_surfaces(const sp_mesh *mesh, const sp_layout *layout, const doubl
   if (rc == SP_OK) {
     for (int i = 0; i < 3; ++i)
       if (fs[i].n) qsort(fs[i].f, fs[i].n, sizeof *fs[i].f, sp_cmp_far_first);
-    rc = sp_white_surface(cam.w, cam.h, path, &surf);
+    int legend = 0;
+    rc = sp_legend_height(&cam, layout->n_cells, names, path, &legend);
+    if (rc == SP_OK) rc = sp_white_surface(cam.w, cam.h + legend, path, &surf);
   }
-  if (rc == SP_OK) rc = sp_draw_surfaces(surf, &cam, fs, t);
+  if (rc == SP_OK) rc = sp_draw_surfaces(surf, &cam, fs, t, layout->n_cells, names);
   if (rc == SP_OK) rc = sp_png_write(surf, path);
   if (surf) cairo_surface_destroy(surf);
   for (int i = 0; i < 3; ++i) free(fs[i].f);

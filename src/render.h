@@ -7,6 +7,7 @@
 #ifndef SP_RENDER_H
 #define SP_RENDER_H
 
+#include "cell_obs.h"
 #include "layout.h"
 #include "mesh.h"
 
@@ -17,9 +18,12 @@ extern "C" {
 #endif
 
 /** @brief Picture of the cells of @p state, @p width_px wide (height from the
- *         domain's aspect ratio), with the time in a corner. */
+ *         domain's aspect ratio), with the time in a corner; with @p names
+ *         (a named scene's, NULL: none) each cell's name (its number if it
+ *         has none) in bold black on a white halo at the mean position of
+ *         the nodes where it is the cell_id (the largest c > 1/2). */
 int sp_render_cells(const sp_mesh *mesh, const sp_layout *layout,
-                    const double *state, double t, int width_px,
+                    const double *state, double t, const sp_cell_name *names, int width_px,
                     const char *path);
 
 /**
@@ -52,10 +56,13 @@ int sp_render_contact_graph(const sp_mesh *mesh, int n_cells, const double *cent
  *        @p width_px wide: phi = max_k c_k interpolated trilinearly in the
  *        hexahedron under each pixel, in the 2D picture's colours (buffer
  *        elements washed out, white outside the mesh), each panel with its
- *        plane and axes labelled, the time above.
+ *        plane and axes labelled, the time above; with @p names (NULL:
+ *        none) each cell's name, as in sp_render_cells, at the mean of the
+ *        pixels of each panel where it has the largest c > 1/2 (trilinear),
+ *        if they are at least a label's height squared.
  */
 int sp_render_sections(const sp_mesh *mesh, const sp_layout *layout, const double *state,
-                       double t, int width_px, const char *path);
+                       double t, const sp_cell_name *names, int width_px, const char *path);
 
 /**
  * @brief Where sp_render_sections puts the point @p x (3 coordinates) in the
@@ -74,13 +81,17 @@ int sp_render_sections_pixel(const sp_mesh *mesh, int width_px, int plane, const
  *        a fixed oblique orthographic camera, inside the boundary of Omega
  *        drawn translucent (the eggshell's inner surface, or the box), with
  *        the axes' directions in a corner and the time above; @p width_px
- *        wide, the height from the mesh's projection.
+ *        wide, the height from the mesh's projection. With @p names (NULL:
+ *        none) a legend strip below the view, as many rows as it needs:
+ *        each cell's colour in a square and its name (its number if it has
+ *        none); the view above it is the same pixel for pixel.
  */
 int sp_render_surfaces(const sp_mesh *mesh, const sp_layout *layout, const double *state,
-                       double t, int width_px, const char *path);
+                       double t, const sp_cell_name *names, int width_px, const char *path);
 
 /** @brief Where sp_render_surfaces puts the point @p x (3 coordinates), as
- *         sp_render_cells_pixel, and the picture's height. */
+ *         sp_render_cells_pixel, and the picture's height without names
+ *         (a legend strip adds to it). */
 int sp_render_surfaces_pixel(const sp_mesh *mesh, int width_px, const double *x, double *px,
                              double *py, int *height_px);
 

@@ -40,12 +40,21 @@ static inline energy_trend energy_trend_read(const char *path) {
   return tr;
 }
 
-/* A CSV log with a header line: every value as a double. */
+/* A CSV log with a header line: every value as a double (0 where it is not
+ * a number) and as its text (the name columns; at most 39 characters).
+ * One allocation: free(t.v) or csv_free frees both. */
 typedef struct {
   int n_rows, n_cols;
   char header[1024];
-  double *v; /* n_rows x n_cols */
+  double *v;       /* n_rows x n_cols */
+  char (*str)[40]; /* n_rows x n_cols, after v's room in the same block */
 } csv_table;
+
+static inline void csv_free(csv_table *t) {
+  free(t->v);
+  t->v = NULL;
+  t->str = NULL;
+}
 
 static inline int csv_read(const char *path, csv_table *t) {
   memset(t, 0, sizeof *t);
@@ -60,14 +69,22 @@ static inline int csv_read(const char *path, csv_table *t) {
   t->n_cols = 1;
   for (const char *c = t->header; *c; ++c) t->n_cols += *c == ',';
   while (fgets(line, sizeof line, f)) {
-    if (t->n_rows == cap) {
+    if (t->n_rows == cap) { /* doubles for cap rows, then their texts */
+      const size_t old = (size_t)cap * t->n_cols;
       cap = cap ? 2 * cap : 256;
-      t->v = realloc(t->v, (size_t)cap * t->n_cols * sizeof(double));
+      const size_t room = (size_t)cap * t->n_cols;
+      t->v = realloc(t->v, room * (sizeof(double) + sizeof *t->str));
+      t->str = (char(*)[40])(t->v + room);
+      memmove(t->str, t->v + old, old * sizeof *t->str);
     }
-    char *s = line;
-    for (int j = 0; j < t->n_cols; ++j) {
-      t->v[(size_t)t->n_rows * t->n_cols + j] = strtod(s, &s);
-      if (*s == ',') ++s;
+    line[strcspn(line, "\r\n")] = '\0';
+    const char *s = line;
+    for (int j = 0; j < t->n_cols; ++j) { /* field j: up to the next comma */
+      const size_t len = strcspn(s, ",");
+      const size_t ij = (size_t)t->n_rows * t->n_cols + j;
+      snprintf(t->str[ij], sizeof t->str[ij], "%.*s", (int)len, s);
+      t->v[ij] = strtod(t->str[ij], NULL);
+      s += len + (s[len] == ',');
     }
     ++t->n_rows;
   }
@@ -75,19 +92,79 @@ static inline int csv_read(const char *path, csv_table *t) {
   return 0;
 }
 
-static inline int csv_col(const csv_table *t, const char *name) {
+/* The index of column @p name, or -1. */
+static inline int csv_find(const csv_table *t, const char *name) {
   char h[1024];
   snprintf(h, sizeof h, "%s", t->header);
   h[strcspn(h, "\r\n")] = '\0';
   int j = 0;
   for (char *tok = strtok(h, ","); tok; tok = strtok(NULL, ","), ++j)
     if (strcmp(tok, name) == 0) return j;
-  CHECK(0, "no column %s", name);
-  return 0;
+  return -1;
+}
+
+static inline int csv_col(const csv_table *t, const char *name) {
+  const int j = csv_find(t, name);
+  CHECK(j >= 0, "no column %s", name);
+  return j < 0 ? 0 : j;
 }
 
 static inline double at(const csv_table *t, int i, const char *name) {
   return t->v[(size_t)i * t->n_cols + csv_col(t, name)];
+}
+
+/* The text of column @p name in row @p i (a name column). */
+static inline const char *at_str(const csv_table *t, int i, const char *name) {
+  return t->str[(size_t)i * t->n_cols + csv_col(t, name)];
+}
+
+/* A row of a named scene's divisions.csv (docs/output.md): the cut's
+ * normal from long_x, long_y, long_z in 3D, (cos, sin) of axis_angle in
+ * 2D (angle: axis_angle, NAN in 3D). */
+typedef struct {
+  double t, angle, normal[3], before, a, b, fraction;
+  int step, parent, child;
+  char parent_name[32], first[32], second[32];
+} division_row;
+
+/* The rows of @p dir/divisions.csv, at most @p cap: their number; -1 if it
+ * cannot be read or its header is not @p header (NULL: any). */
+static inline int divisions_read(const char *dir, const char *header, division_row *rows,
+                                 int cap) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/divisions.csv", dir);
+  csv_table t;
+  if (csv_read(path, &t) != 0) return -1;
+  if (header && strcmp(t.header, header) != 0) {
+    csv_free(&t);
+    return -1;
+  }
+  const int in_3d = csv_find(&t, "long_x") >= 0;
+  int n = 0;
+  for (int i = 0; i < t.n_rows && n < cap; ++i, ++n) {
+    division_row *r = &rows[n];
+    r->t = at(&t, i, "t");
+    r->step = (int)at(&t, i, "step");
+    r->parent = (int)at(&t, i, "parent");
+    r->child = (int)at(&t, i, "child");
+    r->angle = in_3d ? NAN : at(&t, i, "axis_angle");
+    if (in_3d) {
+      r->normal[0] = at(&t, i, "long_x");
+      r->normal[1] = at(&t, i, "long_y");
+      r->normal[2] = at(&t, i, "long_z");
+    } else {
+      r->normal[0] = cos(r->angle), r->normal[1] = sin(r->angle), r->normal[2] = 0;
+    }
+    r->before = at(&t, i, "parent_mass_before");
+    r->a = at(&t, i, "parent_mass_after");
+    r->b = at(&t, i, "child_mass_after");
+    r->fraction = at(&t, i, "fraction");
+    snprintf(r->parent_name, sizeof r->parent_name, "%s", at_str(&t, i, "parent_name"));
+    snprintf(r->first, sizeof r->first, "%s", at_str(&t, i, "first_name"));
+    snprintf(r->second, sizeof r->second, "%s", at_str(&t, i, "second_name"));
+  }
+  csv_free(&t);
+  return n;
 }
 
 /** The total mass of the cells at @p step in cells.csv (NAN if unreadable);
@@ -105,7 +182,7 @@ static inline double cells_mass_at(const char *path, int step, int cap, int *n_c
     total += m;
     if (n_cells && masses && *n_cells < cap) masses[(*n_cells)++] = m;
   }
-  free(t.v);
+  csv_free(&t);
   return total;
 }
 
@@ -128,7 +205,7 @@ static inline int cells_column(const char *dir, const char *name, double *v, int
     v[s * n_cells + k] = at(&t, i, name);
     if (s + 1 > steps) steps = s + 1;
   }
-  free(t.v);
+  csv_free(&t);
   return steps;
 }
 
@@ -198,5 +275,30 @@ static inline unsigned char *vtu_array_data(const char *xml, const char *name, s
   memmove(raw, raw + 8, header);
   *bytes = header;
   return raw;
+}
+
+/* The strings of the String DataArray @p name in @p xml (VTK's ASCII form:
+ * each string's character codes, then a 0) into @p out, at most @p cap of
+ * at most 31 characters: their number, -1 if the array is absent or its
+ * NumberOfTuples is not the number of strings. */
+static inline int vtu_strings(const char *xml, const char *name, char (*out)[32], int cap) {
+  char key[64];
+  snprintf(key, sizeof key, "type=\"String\" Name=\"%s\"", name);
+  const char *p = strstr(xml, key);
+  const char *tuples = p ? strstr(p, "NumberOfTuples=\"") : NULL;
+  if (!p || !tuples || !(p = strchr(p, '>'))) return -1;
+  const int declared = atoi(tuples + strlen("NumberOfTuples=\""));
+  int n = 0, len = 0;
+  char *end;
+  for (long c = strtol(p + 1, &end, 10); end != p + 1; c = strtol(p + 1, &end, 10)) {
+    p = end;
+    if (c == 0) {
+      if (n < cap) out[n][len < 31 ? len : 31] = '\0';
+      ++n, len = 0;
+    } else if (n < cap && len < 31) {
+      out[n][len++] = (char)c;
+    }
+  }
+  return n == declared ? n : -1;
 }
 #endif

@@ -12,6 +12,8 @@
  *   and P3; each cell's mass as a fraction of the 8 cells' is the product
  *   of the fractions along its lineage to 1e-9 relative (every cell's
  *   mass is conserved between divisions);
+ * - the last fields file's cell_name array (FieldData) has the 8 names,
+ *   cell k's at tuple k - 1 as in cells.csv;
  * - each cell's area (c >= 1/2) as a fraction of the 8 cells' is the
  *   atlas's volume fraction V_i / sum V within d / R_i relative, where d =
  *   sqrt(kappa / 2 alpha) is the interface width and R_i = sqrt(A_i / pi)
@@ -26,6 +28,7 @@
 
 #include "check.h"
 #include "error.h"
+#include "output_read.h"
 #include "run.h"
 
 #define SCENE SP_SOURCE_DIR "/inputs/embryo/celegans_8_2d.yaml"
@@ -50,60 +53,24 @@ static int atlas_index(const char *name) {
 }
 
 typedef struct {
-  double t, before, a, b, fraction;
-  char parent[32], first[32], second[32];
-} division_row;
-
-static int read_divisions(division_row *rows, int cap) {
-  FILE *f = fopen(OUT "/divisions.csv", "r");
-  CHECK(f, "no divisions.csv");
-  if (!f) return 0;
-  char line[1024];
-  int n = 0;
-  CHECK(fgets(line, sizeof line, f) != NULL, "empty divisions.csv");
-  while (n < cap && fgets(line, sizeof line, f)) {
-    division_row *r = &rows[n];
-    int step, parent, child;
-    double angle;
-    if (sscanf(line, "%lf,%d,%d,%d,%lf,%lf,%lf,%lf,%31[^,],%31[^,],%31[^,],%lf", &r->t, &step,
-               &parent, &child, &angle, &r->before, &r->a, &r->b, r->parent, r->first,
-               r->second, &r->fraction) == 12)
-      ++n;
-    else
-      CHECK(0, "divisions.csv row %d: %s", n + 1, line);
-  }
-  fclose(f);
-  return n;
-}
-
-typedef struct {
   double mass, area;
   char name[32];
 } cell_row;
 
 /** The rows of cells.csv's last step: their number. */
 static int read_last_cells(int last_step, cell_row *rows, int cap) {
-  FILE *f = fopen(OUT "/cells.csv", "r");
-  CHECK(f, "no cells.csv");
-  if (!f) return 0;
-  char line[2048];
+  csv_table t;
+  CHECK(csv_read(OUT "/cells.csv", &t) == 0, "no cells.csv");
+  CHECK(!strcmp(t.header, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass,area,name\n"),
+        "cells.csv header: %s", t.header);
   int n = 0;
-  CHECK(fgets(line, sizeof line, f) &&
-            !strcmp(line, "step,t,cell,mass,xc,yc,I1,I2,angle,core_mass,area,name\n"),
-        "cells.csv header: %s", line);
-  while (fgets(line, sizeof line, f)) {
-    int step, cell;
-    double t, mass, xc, yc, i1, i2, angle, core, area;
-    char name[32];
-    if (sscanf(line, "%d,%lf,%d,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%31[^\n]", &step, &t, &cell,
-               &mass, &xc, &yc, &i1, &i2, &angle, &core, &area, name) != 12 ||
-        step != last_step || n >= cap)
-      continue;
-    rows[n] = (cell_row){.mass = mass, .area = area};
-    memcpy(rows[n].name, name, sizeof name);
+  for (int i = 0; i < t.n_rows && n < cap; ++i) {
+    if ((int)at(&t, i, "step") != last_step) continue;
+    rows[n] = (cell_row){.mass = at(&t, i, "mass"), .area = at(&t, i, "area")};
+    snprintf(rows[n].name, sizeof rows[n].name, "%s", at_str(&t, i, "name"));
     ++n;
   }
-  fclose(f);
+  csv_free(&t);
   return n;
 }
 
@@ -119,28 +86,29 @@ int main(int argc, char **argv) {
         sum.divisions, sum.n_cells);
 
   division_row rows[N_DIV + 2];
-  const int n = read_divisions(rows, N_DIV + 2);
+  const int n = divisions_read(OUT, NULL, rows, N_DIV + 2);
   CHECK(n == N_DIV, "%d rows in divisions.csv, the table has %d", n, N_DIV);
   double t_of[N_ATLAS], share_of[N_ATLAS]; /* a parent's division time; a cell's share */
   for (int i = 0; i < N_ATLAS; ++i) t_of[i] = NAN, share_of[i] = 1.0;
   for (int i = 0; i < n; ++i) {
     const division_row *r = &rows[i];
-    const int p = atlas_index(r->parent), a = atlas_index(r->first), b = atlas_index(r->second);
-    CHECK(p >= 0 && a >= 0 && b >= 0 && !strcmp(atlas[a].parent, r->parent) &&
-              !strcmp(atlas[b].parent, r->parent),
-          "division %d: %s -> %s, %s is not the lineage's", i + 1, r->parent, r->first,
+    const int p = atlas_index(r->parent_name), a = atlas_index(r->first),
+              b = atlas_index(r->second);
+    CHECK(p >= 0 && a >= 0 && b >= 0 && !strcmp(atlas[a].parent, r->parent_name) &&
+              !strcmp(atlas[b].parent, r->parent_name),
+          "division %d: %s -> %s, %s is not the lineage's", i + 1, r->parent_name, r->first,
           r->second);
     if (p < 0 || a < 0 || b < 0) continue;
     const double ratio = atlas[a].volume / (atlas[a].volume + atlas[b].volume);
     const double share = r->a / r->before;
     printf("t = %.6f: %-3s -> %-4s %-4s table %.6f (atlas %.6f), share %.12f\n", r->t,
-           r->parent, r->first, r->second, r->fraction, ratio, share);
+           r->parent_name, r->first, r->second, r->fraction, ratio, share);
     CHECK(fabs(r->fraction - ratio) <= 5e-7, "%s: the table's %.17g, the atlas's %.17g",
-          r->parent, r->fraction, ratio);
-    CHECK(fabs(share - r->fraction) <= 1e-9, "%s: share %.12f, table %.12f", r->parent, share,
-          r->fraction);
+          r->parent_name, r->fraction, ratio);
+    CHECK(fabs(share - r->fraction) <= 1e-9, "%s: share %.12f, table %.12f", r->parent_name,
+          share, r->fraction);
     CHECK(fabs(r->a + r->b - r->before) <= 1e-12 * r->before, "%s: %.17g + %.17g != %.17g",
-          r->parent, r->a, r->b, r->before);
+          r->parent_name, r->a, r->b, r->before);
     t_of[p] = r->t;
     share_of[a] = r->fraction;
     share_of[b] = 1 - r->fraction;
@@ -181,6 +149,26 @@ int main(int argc, char **argv) {
     CHECK(off <= d / radius, "%s: area fraction %.5f, atlas %.5f: %.4f off, above d/R = %.4f",
           cells[k].name, af, want, off, d / radius);
   }
+
+  /* The last fields file (fields.pvd's last DataSet) names every cell, cell
+   * k's name at tuple k - 1, as cells.csv does at the end. */
+  char *pvd = slurp(OUT "/fields.pvd", NULL), vtu[256] = "";
+  const char *last = NULL;
+  for (const char *p = pvd; p && (p = strstr(p, "file=\"")); p += 6) last = p + 6;
+  if (last) snprintf(vtu, sizeof vtu, OUT "/%.*s", (int)strcspn(last, "\""), last);
+  char *xml = slurp(vtu, NULL);
+  CHECK(xml != NULL, "cannot read the last fields file '%s'", vtu);
+  char names[N_FINAL + 2][32];
+  const int n_names = xml ? vtu_strings(xml, "cell_name", names, N_FINAL + 2) : -1;
+  CHECK(n_names == N_FINAL, "%s: %d names in cell_name", vtu, n_names);
+  for (int k = 0; k < n_names && k < m; ++k)
+    CHECK(!strcmp(names[k], cells[k].name), "%s: cell %d is %s, cells.csv says %s", vtu, k + 1,
+          names[k], cells[k].name);
+  printf("%s: cell_name", vtu);
+  for (int k = 0; k < n_names; ++k) printf(" %s", names[k]);
+  printf("\n");
+  free(xml);
+  free(pvd);
   MPI_Finalize();
   TEST_DONE();
 }

@@ -32,59 +32,27 @@ static const char divisions_header[] =
     "t,step,parent,child,long_x,long_y,long_z,parent_mass_before,parent_mass_after,"
     "child_mass_after,parent_name,first_name,second_name,fraction\n";
 
-typedef struct {
-  int step, parent, child;
-  double normal[3], before, a, b, fraction;
-  char parent_name[32], first[32], second[32];
-} division_row;
-
-static int read_divisions(division_row *rows, int cap) {
-  FILE *f = fopen(OUT "/divisions.csv", "r");
-  CHECK(f, "no divisions.csv");
-  if (!f) return 0;
-  char line[1024];
-  int n = 0;
-  CHECK(fgets(line, sizeof line, f) && !strcmp(line, divisions_header),
-        "divisions.csv header: %s", line);
-  while (n < cap && fgets(line, sizeof line, f)) {
-    division_row *r = &rows[n];
-    double t;
-    if (sscanf(line, "%lf,%d,%d,%d,%lf,%lf,%lf,%lf,%lf,%lf,%31[^,],%31[^,],%31[^,],%lf", &t,
-               &r->step, &r->parent, &r->child, &r->normal[0], &r->normal[1], &r->normal[2],
-               &r->before, &r->a, &r->b, r->parent_name, r->first, r->second,
-               &r->fraction) == 14)
-      ++n;
-  }
-  fclose(f);
-  return n;
-}
-
 /** cells.csv: mass[step][cell] (NAN where the cell does not exist), the
  *  names of the last step's cells; the number of steps + 1. */
 static int read_cells(double (*mass)[MAX_CELLS], char names[MAX_CELLS][32], char *first) {
-  FILE *f = fopen(OUT "/cells.csv", "r");
-  CHECK(f, "no cells.csv");
-  if (!f) return 0;
-  char line[2048];
+  csv_table t;
+  CHECK(csv_read(OUT "/cells.csv", &t) == 0, "no cells.csv");
   for (int s = 0; s < CAP; ++s)
     for (int k = 0; k < MAX_CELLS; ++k) mass[s][k] = NAN;
-  CHECK(fgets(line, sizeof line, f) && strstr(line, ",core_mass,volume,name\n"),
-        "cells.csv header: %s", line);
+  const size_t hl = strlen(t.header), tail = strlen(",core_mass,volume,name\n");
+  CHECK(hl >= tail && !strcmp(t.header + hl - tail, ",core_mass,volume,name\n"),
+        "cells.csv header: %s", t.header);
   int steps = 0;
-  while (fgets(line, sizeof line, f)) {
-    int s, k;
-    double t, m;
-    if (sscanf(line, "%d,%lf,%d,%lf", &s, &t, &k, &m) != 4 || s < 0 || s >= CAP || k < 1 ||
-        k > MAX_CELLS)
-      continue;
-    mass[s][k - 1] = m;
-    const char *name = strrchr(line, ',') + 1;
-    const int len = (int)strcspn(name, "\n");
-    if (s == 0 && k == 1) snprintf(first, 32, "%.*s", len, name);
+  for (int i = 0; i < t.n_rows; ++i) {
+    const int s = (int)at(&t, i, "step"), k = (int)at(&t, i, "cell");
+    if (s < 0 || s >= CAP || k < 1 || k > MAX_CELLS) continue;
+    mass[s][k - 1] = at(&t, i, "mass");
+    const char *name = at_str(&t, i, "name");
+    if (s == 0 && k == 1) snprintf(first, 32, "%s", name);
     if (s + 1 > steps) steps = s + 1;
-    snprintf(names[k - 1], 32, "%.*s", len, name);
+    snprintf(names[k - 1], 32, "%s", name);
   }
-  fclose(f);
+  csv_free(&t);
   return steps;
 }
 
@@ -106,8 +74,9 @@ int main(int argc, char **argv) {
         sum.n_cells);
 
   division_row rows[4];
-  const int n = read_divisions(rows, 4);
-  CHECK(n == 3, "%d named rows in divisions.csv", n);
+  const int n = divisions_read(OUT, divisions_header, rows, 4);
+  CHECK(n == 3, "%d named rows in divisions.csv (-1: unreadable or not the header %s)", n,
+        divisions_header);
   static const struct {
     const char *parent, *first, *second;
     double fraction;

@@ -25,37 +25,6 @@
 #define SCENE SP_SOURCE_DIR "/tests/scenes/lineage_two_gen.yaml"
 #define PI 3.14159265358979323846
 
-typedef struct {
-  double t, angle, before, a, b, fraction;
-  int parent, child;
-  char parent_name[32], first[32], second[32];
-} division_row;
-
-/** The rows of a named run's divisions.csv (at most @p cap); -1 if the
- *  header is not the named one. */
-static int read_divisions(const char *path, division_row *rows, int cap) {
-  FILE *f = fopen(path, "r");
-  if (!f) return -1;
-  char line[1024];
-  int n = 0;
-  if (!fgets(line, sizeof line, f) ||
-      strcmp(line, "t,step,parent,child,axis_angle,parent_mass_before,parent_mass_after,"
-                   "child_mass_after,parent_name,first_name,second_name,fraction\n") != 0) {
-    fclose(f);
-    return -1;
-  }
-  while (n < cap && fgets(line, sizeof line, f)) {
-    division_row *r = &rows[n];
-    int step;
-    if (sscanf(line, "%lf,%d,%d,%d,%lf,%lf,%lf,%lf,%31[^,],%31[^,],%31[^,],%lf", &r->t, &step,
-               &r->parent, &r->child, &r->angle, &r->before, &r->a, &r->b, r->parent_name,
-               r->first, r->second, &r->fraction) == 12)
-      ++n;
-  }
-  fclose(f);
-  return n;
-}
-
 /** The names of cells.csv's rows of step @p step, in order (at most @p cap):
  *  their number. */
 static int names_at(const char *path, int step, char names[][32], int cap) {
@@ -97,7 +66,11 @@ int main(int argc, char **argv) {
         whole.n_cells);
 
   division_row rows[8];
-  const int n = read_divisions("lineage_whole/divisions.csv", rows, 8);
+  const int n = divisions_read("lineage_whole",
+                               "t,step,parent,child,axis_angle,parent_mass_before,"
+                               "parent_mass_after,child_mass_after,parent_name,first_name,"
+                               "second_name,fraction\n",
+                               rows, 8);
   CHECK(n == 3, "%d named rows in divisions.csv", n);
   static const struct {
     const char *parent, *first, *second;

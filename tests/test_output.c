@@ -1,7 +1,10 @@
 /* Output and rendering: CSV logs round-trip exactly, the .vtu holds the
  * right sizes and values (decoded from its base64), fields.pvd lists every
  * output once, the PNGs are PNGs with the paper's colours where expected,
- * and a directory that cannot be created is an SP_ERR_IO naming the path.
+ * a named scene's .vtu holds its cells' names (cell_name) and its cells
+ * picture their labels, differing from the unnamed picture only within the
+ * labels' boxes, and a directory that cannot be created is an SP_ERR_IO
+ * naming the path.
  *
  * The mesh is built by hand (a 6 x 3 rectangle of unit-free quads) so this
  * test depends on no other module than layout and error. */
@@ -172,8 +175,8 @@ int main(void) {
   CHECK_OK(sp_output_cells(out, 10, tv[1], 2, obs, NULL));
 
   /* ---- two field outputs (the second on the masked layout) ---- */
-  CHECK_OK(sp_output_fields(out, &mesh, full, state, 10, tv[1]));
-  CHECK_OK(sp_output_fields(out, &mesh, masked, state_m, 20, tv[2]));
+  CHECK_OK(sp_output_fields(out, &mesh, full, state, 10, tv[1], NULL));
+  CHECK_OK(sp_output_fields(out, &mesh, masked, state_m, 20, tv[2], NULL));
 
   /* ---- energy.csv: rows are there before close (flushed), exact ---- */
   {
@@ -347,7 +350,7 @@ int main(void) {
     }
     /* Writing step 20 again (a redone step) must replace, not append. */
     if (pass == 0)
-      CHECK_OK(sp_output_fields(out, &mesh, masked, state_m, 20, tv[2]));
+      CHECK_OK(sp_output_fields(out, &mesh, masked, state_m, 20, tv[2], NULL));
   }
   CHECK(!exists(DIR "/fields.pvd.tmp") && !exists(DIR "/fields_000010.vtu.tmp"),
         "temporary files left behind");
@@ -361,7 +364,7 @@ int main(void) {
     const char *png = "test_output_tmp/cells.png";
     const int width = 480;
     remove(png);
-    CHECK_OK(sp_render_cells(&mesh, full, state, 1.234e-2, width, png));
+    CHECK_OK(sp_render_cells(&mesh, full, state, 1.234e-2, NULL, width, png));
     CHECK(is_png(png), "%s is not a PNG", png);
     CHECK(!exists("test_output_tmp/cells.png.tmp"), "cells.png.tmp left");
     cairo_surface_t *s = cairo_image_surface_create_from_png(png);
@@ -392,6 +395,69 @@ int main(void) {
             rgb[2]);
     }
     cairo_surface_destroy(s);
+  }
+
+  /* ---- a named scene's fields: FieldData's cell_name, one string a cell
+   * (an unnamed cell's ""), and none in an unnamed scene's .vtu ---- */
+  {
+    const sp_cell_name names[2] = {"AB", ""};
+    sp_output named = NULL;
+    CHECK_OK(sp_output_open_dim("test_output_tmp/named", 2, 1, &named));
+    CHECK_OK(sp_output_fields(named, &mesh, full, state, 3, 0.5, names));
+    CHECK_OK(sp_output_close(&named));
+    char *xml = slurp("test_output_tmp/named/fields_000003.vtu", NULL);
+    char got[3][32];
+    const int n = xml ? vtu_strings(xml, "cell_name", got, 3) : -1;
+    CHECK(n == 2 && !strcmp(got[0], "AB") && !strcmp(got[1], ""),
+          "named .vtu: %d names (%s, %s)", n, n > 0 ? got[0] : "-", n > 1 ? got[1] : "-");
+    free(xml);
+    xml = slurp(DIR "/fields_000010.vtu", NULL);
+    CHECK(xml && !strstr(xml, "cell_name"), "an unnamed scene's .vtu has cell_name");
+    free(xml);
+  }
+
+  /* ---- names on the cells picture: each cell's label at the mean of its
+   * nodes (cell 1: columns 0-1, centre (0.25, 0.75); cell 2: columns 4-6,
+   * (2.5, 0.75); nodes 0.5 apart); every pixel farther than a label's box from both is the
+   * unnamed picture's ---- */
+  {
+    const int width = 480;
+    const sp_cell_name names[2] = {"AB", ""}; /* cell 2 is labelled "2" */
+    CHECK_OK(sp_render_cells(&mesh, full, state, 1.234e-2, names, width,
+                             "test_output_tmp/cells_named.png"));
+    cairo_surface_t *a = cairo_image_surface_create_from_png("test_output_tmp/cells.png");
+    cairo_surface_t *b = cairo_image_surface_create_from_png("test_output_tmp/cells_named.png");
+    CHECK(cairo_surface_status(b) == CAIRO_STATUS_SUCCESS &&
+              cairo_image_surface_get_width(a) == cairo_image_surface_get_width(b) &&
+              cairo_image_surface_get_height(a) == cairo_image_surface_get_height(b),
+          "the named picture's size differs");
+    if (cairo_surface_status(b) == CAIRO_STATUS_SUCCESS &&
+        cairo_image_surface_get_height(a) == cairo_image_surface_get_height(b)) {
+      const double font = fmax(10.0, width / 45.0); /* the picture's font */
+      double px[2], py[2];
+      CHECK_OK(sp_render_cells_pixel(&mesh, width, 0.25, 0.75, &px[0], &py[0], NULL));
+      CHECK_OK(sp_render_cells_pixel(&mesh, width, 2.5, 0.75, &px[1], &py[1], NULL));
+      int near[2] = {0, 0}, far = 0;
+      for (int j = 0; j < cairo_image_surface_get_height(a); ++j)
+        for (int i = 0; i < width; ++i) {
+          double ca[3], cb[3];
+          png_pixel(a, i, j, ca);
+          png_pixel(b, i, j, cb);
+          const int differs = ca[0] != cb[0] || ca[1] != cb[1] || ca[2] != cb[2];
+          int inside = 0; /* a label's box: 2 bold letters and the halo */
+          for (int k = 0; k < 2; ++k)
+            if (fabs(i + 0.5 - px[k]) <= 1.5 * font && fabs(j + 0.5 - py[k]) <= font) {
+              near[k] += differs;
+              inside = 1;
+            }
+          far += differs && !inside;
+        }
+      CHECK(near[0] > 0 && near[1] > 0, "no label at the cells: %d and %d pixels differ",
+            near[0], near[1]);
+      CHECK(far == 0, "%d pixels away from the labels differ from the unnamed picture", far);
+    }
+    cairo_surface_destroy(a);
+    cairo_surface_destroy(b);
   }
 
   /* ---- contact graph: the cells picture's frame, an edge a quarter of

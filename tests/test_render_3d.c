@@ -11,6 +11,10 @@
  *    the disc c >= 1/2 (the pixels where jet's red reaches its blue: they
  *    cross at 1/2) covers pi r^2 pixels to within the pixels along its rim
  *    (2 pi r, in pixels);
+ *  - with a name (a named scene's), the sections differ from the unnamed
+ *    ones only within a label's box at the disc's centre in each panel,
+ *    and the 3D view is the unnamed one pixel for pixel above a legend
+ *    strip that holds the cell's colour;
  *  - `softpack run` of a 3D scene with pictures writes sections_<step>.png
  *    and surfaces_<step>.png picture_width wide and as high as
  *    sp_render_sections_pixel and sp_render_surfaces_pixel say, the
@@ -156,6 +160,83 @@ static void pixel(cairo_surface_t *s, int i, int j, int rgb[3]) {
   rgb[0] = p >> 16 & 0xff, rgb[1] = p >> 8 & 0xff, rgb[2] = p & 0xff;
 }
 
+/** The pixels of @p b that differ from @p a's (same width; a's rows
+ *  only): within (half-width @p rx, half-height @p ry) of one of the @p n
+ *  points (px[i], py[i]) into near[i], elsewhere into *far. */
+static void differences(cairo_surface_t *a, cairo_surface_t *b, int n, const double *px,
+                        const double *py, double rx, double ry, int *near, int *far) {
+  *far = 0;
+  for (int i = 0; i < n; ++i) near[i] = 0;
+  for (int j = 0; j < cairo_image_surface_get_height(a); ++j)
+    for (int i = 0; i < cairo_image_surface_get_width(a); ++i) {
+      int ca[3], cb[3], inside = 0;
+      pixel(a, i, j, ca);
+      pixel(b, i, j, cb);
+      const int differs = ca[0] != cb[0] || ca[1] != cb[1] || ca[2] != cb[2];
+      for (int k = 0; k < n; ++k)
+        if (fabs(i + 0.5 - px[k]) <= rx && fabs(j + 0.5 - py[k]) <= ry) {
+          near[k] += differs;
+          inside = 1;
+        }
+      *far += differs && !inside;
+    }
+}
+
+/** A named sphere: its name in each section panel at the disc's centre,
+ *  and nothing else changed; the 3D view the unnamed one's pixel for pixel
+ *  above a legend strip holding the cell's colour (the first of the view's
+ *  palette, 0.86 0.25 0.20). */
+static void names_on_3d_pictures(const sp_mesh *m, const sp_layout *l, const double *state,
+                                 const double *centre) {
+  const int width = 600;
+  const sp_cell_name names[1] = {"P0"};
+  CHECK_OK(sp_render_sections(m, l, state, 0.125, names, width, "test_render_3d_named.png"));
+  cairo_surface_t *a = cairo_image_surface_create_from_png("test_render_3d_sections.png");
+  cairo_surface_t *b = cairo_image_surface_create_from_png("test_render_3d_named.png");
+  CHECK(cairo_image_surface_get_width(b) == width &&
+            cairo_image_surface_get_height(b) == cairo_image_surface_get_height(a),
+        "the named sections are %d x %d", cairo_image_surface_get_width(b),
+        cairo_image_surface_get_height(b));
+  double px[3], py[3];
+  for (int p = 0; p < 3; ++p) CHECK_OK(sp_render_sections_pixel(m, width, p, centre, &px[p], &py[p], NULL));
+  const double font = fmax(10.0, width / 60.0); /* the sections' font */
+  int near[3], far;
+  differences(a, b, 3, px, py, 1.5 * font, font, near, &far);
+  printf("sections named: %d, %d, %d pixels differ at the panels' centres, %d elsewhere\n",
+         near[0], near[1], near[2], far);
+  CHECK(near[0] > 0 && near[1] > 0 && near[2] > 0, "no name in a panel: %d, %d, %d", near[0],
+        near[1], near[2]);
+  CHECK(far == 0, "%d pixels away from the names differ", far);
+  cairo_surface_destroy(a);
+  cairo_surface_destroy(b);
+
+  CHECK_OK(sp_render_surfaces(m, l, state, 0.125, NULL, width, "test_render_3d_view.png"));
+  CHECK_OK(sp_render_surfaces(m, l, state, 0.125, names, width, "test_render_3d_view_named.png"));
+  a = cairo_image_surface_create_from_png("test_render_3d_view.png");
+  b = cairo_image_surface_create_from_png("test_render_3d_view_named.png");
+  int h;
+  CHECK_OK(sp_render_surfaces_pixel(m, width, centre, NULL, NULL, &h));
+  const int hb = cairo_image_surface_get_height(b);
+  CHECK(cairo_image_surface_get_height(a) == h && hb > h, "the view is %d px high, named %d",
+        cairo_image_surface_get_height(a), hb);
+  if (hb > h) {
+    differences(a, b, 0, NULL, NULL, 0, 0, NULL, &far);
+    CHECK(far == 0, "%d pixels of the named view above its legend differ", far);
+    int swatch = 0;
+    for (int j = h; j < hb; ++j)
+      for (int i = 0; i < width; ++i) {
+        int rgb[3];
+        pixel(b, i, j, rgb);
+        swatch += abs(rgb[0] - 219) <= 1 && abs(rgb[1] - 64) <= 1 && abs(rgb[2] - 51) <= 1;
+      }
+    printf("surfaces named: legend strip %d px high, %d px of the cell's colour\n", hb - h,
+           swatch);
+    CHECK(swatch > 0, "the legend strip has no pixel of the cell's colour");
+  }
+  cairo_surface_destroy(a);
+  cairo_surface_destroy(b);
+}
+
 static void sections_of_a_sphere(void) {
   sp_mesh *m;
   CHECK_OK(sp_mesh_box(0, 0, 0, 1, 1, 1, 24, 24, 24, &m));
@@ -170,7 +251,7 @@ static void sections_of_a_sphere(void) {
     state[2 * sp_layout_pair(l, 0, i)] = 0.5 * (1 - tanh((r - R) / W));
   }
   const int width = 600;
-  CHECK_OK(sp_render_sections(m, l, state, 0.125, width, "test_render_3d_sections.png"));
+  CHECK_OK(sp_render_sections(m, l, state, 0.125, NULL, width, "test_render_3d_sections.png"));
   cairo_surface_t *png = cairo_image_surface_create_from_png("test_render_3d_sections.png");
   CHECK(cairo_surface_status(png) == CAIRO_STATUS_SUCCESS, "cannot read the sections back");
   int h;
@@ -206,6 +287,7 @@ static void sections_of_a_sphere(void) {
           disc, expect, rim);
   }
   cairo_surface_destroy(png);
+  names_on_3d_pictures(m, l, state, centre);
   free(state);
   sp_layout_destroy(&l);
   sp_mesh_destroy(&m);
