@@ -1,10 +1,7 @@
 #include "assembly.hpp"
 #include "errors.hpp"
-#include "fault.h"
 #include "jacobian_hand.hpp"
 
-#include <Epetra_FECrsGraph.h>
-#include <Epetra_FEVector.h>
 #include <Sacado_No_Kokkos.hpp>
 
 #include <algorithm>
@@ -13,48 +10,18 @@
 
 namespace sp {
 
-namespace {
-
-// The fault hook (src/fault.h): SOFTPACK_FAULT=NAME:RANK fails that rank
-// at @p phase (assembly: every residual fill; attach: every layout taken),
-// as if an allocation had failed there.
-void fault_in_glue(sp_fault_phase phase, const char *name, int rank) {
-  if (sp_fault_due(phase, rank))
-    throw memory_error(std::string("out of memory at ") + name + " on rank " +
-                       std::to_string(rank) + " (fault injected by SOFTPACK_FAULT=" + name +
-                       ":" + std::to_string(rank) + ")");
-}
-
-}  // namespace
-
-// Per-element scratch: the element's unknowns and step inputs, slot-major.
-struct Assembly::Gathered {
-  int n_cells = 0;
-  std::vector<double> u, c_old, source;
-  std::vector<int> dof;  // global DOF of each element unknown, -1 if absent
-  std::vector<const sp_shape_coef *> shape;
-  ElementInputs inputs(const sp_step_data &d) const {
-    ElementInputs in;
-    in.c_old = c_old.data();
-    in.source = d.source ? source.data() : nullptr;
-    in.shape = d.shape ? shape.data() : nullptr;
-    in.dt = d.dt;
-    in.model = d.model;
-    return in;
-  }
-};
-
-Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
-                   const sp_layout_view &layout)
+Assembly::Assembly(MPI_Comm comm, const sp_mesh_view &mesh, const sp_layout_view &layout)
     : comm_(comm), n_nodes_(layout.n_nodes), n_pairs_(layout.n_pairs),
       n_cells_(layout.n_cells), dim_(mesh.dim), nen_(mesh.nodes_per_elem),
       nq_(sp_q1_qpoints(mesh.dim)) {
   // Each rank's own work before a collective is agreed first (agree_local):
   // a failure on one rank (an allocation) ends every rank here, none is
-  // left in the node map's or the graph's collective.
-  const int P = comm.NumProc(), r = comm.MyPID();
+  // left in the maps' or the graphs' collectives.
+  int P, r;
+  check_mpi(MPI_Comm_size(comm, &P), "MPI_Comm_size");
+  check_mpi(MPI_Comm_rank(comm, &r), "MPI_Comm_rank");
+  rank_ = r;
   long first_node = (long)n_nodes_ * r / P, end_node = (long)n_nodes_ * (r + 1) / P;
-  std::vector<int> my_dofs;
   agree_local(comm_, [&] {
     fault_in_glue(SP_FAULT_ATTACH, "attach", r);
     node_start_.assign(layout.node_start, layout.node_start + layout.n_nodes + 1);
@@ -82,13 +49,11 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
     }
     for (long i = first_node; i < end_node; ++i)
       for (int p = node_start_[i]; p < node_start_[i + 1]; ++p) {
-        my_dofs.push_back(2 * p);
-        my_dofs.push_back(2 * p + 1);
+        my_rows_.push_back(2 * (GlobalId)p);
+        my_rows_.push_back(2 * (GlobalId)p + 1);
       }
   });
-  map_.reset(new Epetra_Map(-1, (int)my_dofs.size(), my_dofs.data(), 0, comm));
 
-  Epetra_FECrsGraph graph(Copy, *map_, 0);
   agree_local(comm_, [&] {
     // Elements: geometry, and the cells living on each with their pairs: the
     // C core's element-slot table (sp_layout_slots, the one place the
@@ -125,37 +90,9 @@ Assembly::Assembly(const Epetra_Comm &comm, const sp_mesh_view &mesh,
       geo_buffer_[e] = mesh.region && mesh.region[e] == 1;
       if (nodes[0] >= first_node && nodes[0] < end_node) my_elems_.push_back(e);
     }
-
-    // Graph: within an element, coupled() entries between present unknowns.
-    for (int e : my_elems_) {
-      const int nc = n_cells_on(e);
-      const int64_t s0 = elem_start_[e];
-      for (int j = 0; j < nc; ++j)
-        for (int a = 0; a < nen_; ++a) {
-          int p = slot_pair_[nen_ * (s0 + j) + a];
-          if (p < 0) continue;
-          for (int f = 0; f < 2; ++f) {
-            std::vector<int> cols;
-            for (int j2 = 0; j2 < nc; ++j2)
-              for (int b = 0; b < nen_; ++b) {
-                int p2 = slot_pair_[nen_ * (s0 + j2) + b];
-                if (p2 < 0) continue;
-                for (int f2 = 0; f2 < 2; ++f2)
-                  if (coupled(j, f, j2, f2)) cols.push_back(2 * p2 + f2);
-              }
-            int row = 2 * p + f;
-            if (graph.InsertGlobalIndices(1, &row, (int)cols.size(), cols.data()) < 0)
-              throw std::runtime_error("graph insertion failed");
-          }
-        }
-    }
   });
-  if (graph.GlobalAssemble() != 0) throw std::runtime_error("graph assembly failed");
-  graph_.reset(new Epetra_CrsGraph(graph));
-  // Contiguous storage (one array of column indices, one offset array): a
-  // matrix made on this graph keeps its values in one array too, which
-  // Solver hands to a backend as they are on one process (newton.cpp).
-  if (graph_->OptimizeStorage() != 0) throw std::runtime_error("graph: OptimizeStorage failed");
+  // (a node's pairs are consecutive: this rank's pairs are too)
+  build_tpetra(node_start_[first_node], node_start_[end_node]);
 }
 
 bool Assembly::same_layout(const sp_layout_view &l) const {
@@ -284,66 +221,9 @@ void Assembly::element_matrix(int e, const sp_step_data &d, const Gathered &g,
   }
 }
 
-void Assembly::residual(const sp_step_data &d, const double *state,
-                        Epetra_Vector &F) const {
-  Epetra_FEVector fe(*map_);
-  Gathered g;
-  std::vector<double> R;
-  std::vector<int> rows;
-  std::vector<double> vals;
-  agree_local(comm_, [&] {
-    fault_in_glue(SP_FAULT_ASSEMBLY, "assembly", comm_.MyPID());
-    for (int e : my_elems_) {
-      gather(e, d, state, g);
-      const int n = 2 * nen_ * g.n_cells;
-      R.assign(n, 0.0);
-      element_residual(geometry(e), g.n_cells, g.u.data(), g.inputs(d), R.data());
-      rows.clear();
-      vals.clear();
-      for (int i = 0; i < n; ++i)
-        if (g.dof[i] >= 0) {
-          rows.push_back(g.dof[i]);
-          vals.push_back(R[i]);
-        }
-      fe.SumIntoGlobalValues((int)rows.size(), rows.data(), vals.data());
-    }
-  });
-  if (fe.GlobalAssemble(Add) != 0) throw std::runtime_error("residual assembly failed");
-  F = *fe(0);
-}
-
-void Assembly::jacobian(const sp_step_data &d, const double *state, int kind,
-                        Epetra_FECrsMatrix &J) const {
-  J.PutScalar(0.0);
-  Gathered g;
-  std::vector<double> R, K, vals;
-  std::vector<int> cols;
-  agree_local(comm_, [&] {
-    for (int e : my_elems_) {
-      gather(e, d, state, g);
-      const int nc = g.n_cells, per_slot = 2 * nen_, n = per_slot * nc;
-      R.assign(n, 0.0);
-      K.assign((size_t)n * n, 0.0);
-      element_matrix(e, d, g, kind, R.data(), K.data());
-      for (int i = 0; i < n; ++i) {
-        if (g.dof[i] < 0) continue;
-        const int j = i / per_slot, f = i % 2;
-        cols.clear();
-        vals.clear();
-        // columns i2 = per_slot j2 + k, in order (no division per entry)
-        for (int j2 = 0, i2 = 0; j2 < nc; ++j2)
-          for (int k = 0; k < per_slot; ++k, ++i2)
-            if (g.dof[i2] >= 0 && coupled(j, f, j2, k % 2)) {
-              cols.push_back(g.dof[i2]);
-              vals.push_back(K[(size_t)i * n + i2]);
-            }
-        int rc = J.SumIntoGlobalValues(g.dof[i], (int)cols.size(), vals.data(), cols.data());
-        if (rc < 0) throw std::runtime_error("Jacobian entry outside the graph");
-      }
-    }
-  });
-  if (J.GlobalAssemble(false, Add, true) != 0)
-    throw std::runtime_error("Jacobian assembly failed");
+void Assembly::element_rhs(int e, const sp_step_data &d, const Gathered &g, double *R) const {
+  std::fill(R, R + 2 * nen_ * g.n_cells, 0.0);
+  element_residual(geometry(e), g.n_cells, g.u.data(), g.inputs(d), R);
 }
 
 sp_energy_parts Assembly::energy(const sp_model_params &m, const double *state) const {
@@ -376,7 +256,7 @@ sp_energy_parts Assembly::energy(const sp_model_params &m, const double *state) 
     }
   });
   double global[4];
-  comm_.SumAll(local, global, 4);
+  check_mpi(MPI_Allreduce(local, global, 4, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
   return sp_energy_parts{global[0], global[1], global[2], global[3]};
 }
 
@@ -411,7 +291,7 @@ double Assembly::compare_jacobians(const sp_step_data &d, const double *state, i
     }
   });
   double global;
-  comm_.MaxAll(&worst, &global, 1);
+  check_mpi(MPI_Allreduce(&worst, &global, 1, MPI_DOUBLE, MPI_MAX, comm_), "MPI_Allreduce");
   return global;
 }
 
@@ -443,8 +323,8 @@ void Assembly::shape_weights(const sp_step_data &d, std::vector<double> &u) cons
     }
   });
   u.resize(mine.size());
-  if (comm_.SumAll(mine.data(), u.data(), (int)mine.size()) != 0)
-    throw std::runtime_error("shape weights: reduction failed");
+  check_mpi(MPI_Allreduce(mine.data(), u.data(), (int)mine.size(), MPI_DOUBLE, MPI_SUM, comm_),
+            "MPI_Allreduce");
 }
 
 void Assembly::element_pass(const sp_step_data &d, const double *state, int kind) const {

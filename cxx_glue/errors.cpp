@@ -1,8 +1,5 @@
 #include "errors.hpp"
 
-#include <Epetra_Comm.h>
-#include <Epetra_MpiComm.h>
-
 #include <exception>
 #include <new>
 
@@ -69,26 +66,35 @@ namespace {
 
 }  // namespace
 
-void agree_local(const Epetra_Comm &comm, const std::function<void()> &local) {
+void agree_local(MPI_Comm comm, const std::function<void()> &local) {
   std::exception_ptr failed;
   try {
     local();
   } catch (...) {
     failed = std::current_exception();
   }
-  const auto *mpi = dynamic_cast<const Epetra_MpiComm *>(&comm);
-  if (!mpi || comm.NumProc() == 1) {
+  int rank, size;
+  check_mpi(MPI_Comm_size(comm, &size), "MPI_Comm_size");
+  if (size == 1) {
     if (failed) std::rethrow_exception(failed);
     return;
   }
+  check_mpi(MPI_Comm_rank(comm, &rank), "MPI_Comm_rank");
   // The failing rank tells the others its class and message, then rethrows.
   std::string what;
   int status = failed ? error_status(failed, what) : SP_SOLVER_OK;
-  const int first = lowest_failure(mpi->Comm(), (bool)failed, status, what);
+  const int first = lowest_failure(comm, (bool)failed, status, what);
   if (first < 0) return;
-  if (first == comm.MyPID()) std::rethrow_exception(failed);
-  throw_as(status, "on rank " + std::to_string(first) + " of " +
-                       std::to_string(comm.NumProc()) + ": " + what);
+  if (first == rank) std::rethrow_exception(failed);
+  throw_as(status, "on rank " + std::to_string(first) + " of " + std::to_string(size) + ": " +
+                       what);
+}
+
+void fault_in_glue(sp_fault_phase phase, const char *name, int rank) {
+  if (sp_fault_due(phase, rank))
+    throw memory_error(std::string("out of memory at ") + name + " on rank " +
+                       std::to_string(rank) + " (fault injected by SOFTPACK_FAULT=" + name +
+                       ":" + std::to_string(rank) + ")");
 }
 
 }  // namespace sp

@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <string>
 
-class Epetra_Comm;
+#include "fault.h"
 
 namespace sp {
 
@@ -56,11 +56,16 @@ int error_status(std::exception_ptr e, std::string &what);
 int lowest_failure(MPI_Comm comm, bool failed, int &status, std::string &why);
 
 // Run @p local, the rank-local part of a step that a collective follows
-// (an element loop before GlobalAssemble or SumAll). If it threw on any
+// (an element loop before an Export or an MPI reduction). If it threw on any
 // rank, every rank throws before the collective, so none is left waiting
 // in it: the failing rank (the lowest, if several) its own exception, the
 // others one of the same class naming that rank and its message. One
 // integer reduction when nothing failed; nothing on one process.
-void agree_local(const Epetra_Comm &comm, const std::function<void()> &local);
+void agree_local(MPI_Comm comm, const std::function<void()> &local);
+
+// The fault hook (src/fault.h) in the glue: SOFTPACK_FAULT=NAME:RANK fails
+// rank @p rank at @p phase (assembly: every residual fill; attach: every
+// layout taken) with a memory_error, as if an allocation had failed there.
+void fault_in_glue(sp_fault_phase phase, const char *name, int rank);
 
 }  // namespace sp

@@ -1,10 +1,9 @@
 // Direct linear solvers behind one small interface on plain CSR arrays, so
 // the Newton code never depends on a backend and the backends never see the
-// Jacobian's Epetra objects (a later move to Tpetra is cheap). MUMPS, KLU,
-// SuperLU and SuperLU_DIST take the arrays through their own C interfaces;
-// KLU2 (Amesos2) builds an Epetra matrix of its own from them
-// (epetra_rows.hpp), GMRES/ILU (Belos, Ifpack2) a Tpetra one
-// (linear_krylov.cpp).
+// Jacobian's Tpetra objects. MUMPS, KLU, SuperLU and SuperLU_DIST take the
+// arrays through their own C interfaces; KLU2 (Amesos2) and GMRES/ILU
+// (Belos, Ifpack2) build a Tpetra matrix of their own from them
+// (tpetra_rows.hpp).
 #ifndef SP_LINEAR_HPP
 #define SP_LINEAR_HPP
 
@@ -88,7 +87,7 @@ std::unique_ptr<DirectSolver> make_mumps(MPI_Comm comm);
 // Serial KLU (SuiteSparse's libklu, linear_klu.cpp); one rank holding all
 // rows (make_gathered under MPI).
 std::unique_ptr<DirectSolver> make_klu();
-// KLU2 through Amesos2 on an Epetra copy of the rows; one process only
+// KLU2 through Amesos2 on a Tpetra copy of the rows; one process only
 // (throws on several: Debian 13.2's Amesos2 is wrong there, STACK.md).
 std::unique_ptr<DirectSolver> make_amesos2_klu2(MPI_Comm comm);
 // GMRES (Belos) preconditioned by ILU(fill) (Ifpack2 RILUK; additive

@@ -1,11 +1,11 @@
-// KLU2 through Amesos2 on an Epetra copy of the CSR rows (epetra_rows.hpp):
+// KLU2 through Amesos2 on a Tpetra copy of the CSR rows (tpetra_rows.hpp):
 // solver.linear: klu2. One process only: Debian 13.2's Amesos2 returns wrong
 // solutions with several ranks (STACK.md), so Solver refuses klu2 there and
 // this backend checks it again. Amesos2's symbolic factorisation (KLU's
 // ordering) is done once per pattern, each factor() overwrites the values
 // in place and refactors numerically.
 #include <Amesos2.hpp>
-#include <Epetra_MultiVector.h>
+#include <Teuchos_DefaultMpiComm.hpp>
 #include <Teuchos_RCP.hpp>
 #include <Trilinos_version.h>
 
@@ -14,16 +14,19 @@
 #include <stdexcept>
 #include <vector>
 
-#include "epetra_rows.hpp"
 #include "linear.hpp"
+#include "tpetra_rows.hpp"
 
 namespace sp {
 namespace {
 
+using Matrix = TpetraRows::Matrix;
+using MV = TpetraRows::MV;
+
 class Amesos2Klu2 final : public DirectSolver {
  public:
-  explicit Amesos2Klu2(MPI_Comm comm) : comm_(comm) {
-    if (comm_.NumProc() != 1)
+  explicit Amesos2Klu2(MPI_Comm comm) : comm_(Teuchos::rcp(new Teuchos::MpiComm<int>(comm))) {
+    if (comm_->getSize() != 1)
       throw std::runtime_error("solver.linear: klu2 (Amesos2) runs on one MPI process only");
     if (!Amesos2::query("KLU2"))
       throw std::runtime_error("solver.linear: klu2 is not available in this Amesos2 build");
@@ -56,15 +59,19 @@ class Amesos2Klu2 final : public DirectSolver {
       return false;
     }
     try {
-      if (!b_ || b_->NumVectors() != nrhs) {
-        b_ = Teuchos::rcp(new Epetra_MultiVector(rows_->matrix().RowMap(), nrhs));
-        x_ = Teuchos::rcp(new Epetra_MultiVector(rows_->matrix().RowMap(), nrhs));
+      if (b_.is_null() || (int)b_->getNumVectors() != nrhs) {
+        b_ = Teuchos::rcp(new MV(rows_->matrix()->getRowMap(), nrhs));
+        x_ = Teuchos::rcp(new MV(rows_->matrix()->getRowMap(), nrhs));
       }
-      for (int j = 0; j < nrhs; ++j)
-        std::copy(B + (size_t)j * n_rows, B + (size_t)(j + 1) * n_rows, (*b_)[j]);
+      {
+        auto b = b_->getLocalViewHost(Tpetra::Access::OverwriteAll);
+        for (int j = 0; j < nrhs; ++j)
+          for (int i = 0; i < n_rows; ++i) b(i, j) = B[(size_t)j * n_rows + i];
+      }
       solver_->solve(x_.ptr(), b_.ptr().getConst());
+      auto x = x_->getLocalViewHost(Tpetra::Access::ReadOnly);
       for (int j = 0; j < nrhs; ++j)
-        std::copy((*x_)[j], (*x_)[j] + n_rows, X + (size_t)j * n_rows);
+        for (int i = 0; i < n_rows; ++i) X[(size_t)j * n_rows + i] = x(i, j);
       return true;
     } catch (const std::exception &e) {
       why = std::string("klu2 (Amesos2): solve failed: ") + e.what();
@@ -84,17 +91,17 @@ class Amesos2Klu2 final : public DirectSolver {
 
   void build(const CsrRows &A) {
     release();
-    rows_ = std::make_unique<EpetraRows>(comm_, A);
-    Teuchos::RCP<const Epetra_CrsMatrix> matrix = Teuchos::rcpFromRef(rows_->matrix());
-    solver_ = Amesos2::create<Epetra_CrsMatrix, Epetra_MultiVector>("KLU2", matrix);
+    rows_ = std::make_unique<TpetraRows>(comm_, A);
+    Teuchos::RCP<const Matrix> matrix = rows_->matrix();
+    solver_ = Amesos2::create<Matrix, MV>("KLU2", matrix);
     solver_->symbolicFactorization();
     ++symbolic_;
   }
 
-  Epetra_MpiComm comm_;
-  std::unique_ptr<EpetraRows> rows_;
-  Teuchos::RCP<Amesos2::Solver<Epetra_CrsMatrix, Epetra_MultiVector>> solver_;
-  Teuchos::RCP<Epetra_MultiVector> b_, x_;
+  Teuchos::RCP<const Teuchos::Comm<int>> comm_;
+  std::unique_ptr<TpetraRows> rows_;
+  Teuchos::RCP<Amesos2::Solver<Matrix, MV>> solver_;
+  Teuchos::RCP<MV> b_, x_;
   bool factored_ = false;
   int symbolic_ = 0;
 };

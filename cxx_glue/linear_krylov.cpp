@@ -15,9 +15,10 @@
 // factory did ("ILU" with overlap 0). Round-off differs (another
 // orthogonalisation code, another ILU code).
 //
-// The Tpetra graph is built once per pattern; each factor() writes the
-// values into the matrix's own array through a slot table (one pass, the
-// graph stays), recomputes the ILU's values and keeps its symbolic part.
+// The Tpetra copy (tpetra_rows.hpp) is built once per pattern; each
+// factor() writes the values into the matrix's own array through a slot
+// table (one pass, the graph stays), recomputes the ILU's values and keeps
+// its symbolic part.
 #include <BelosLinearProblem.hpp>
 #include <BelosSolverFactory_Tpetra.hpp>
 #include <BelosTpetraAdapter.hpp>
@@ -25,9 +26,6 @@
 #include <Kokkos_Core.hpp>
 #include <Teuchos_DefaultMpiComm.hpp>
 #include <Teuchos_ParameterList.hpp>
-#include <Tpetra_CrsMatrix.hpp>
-#include <Tpetra_Map.hpp>
-#include <Tpetra_MultiVector.hpp>
 #include <Trilinos_version.h>
 
 #include <algorithm>
@@ -39,6 +37,7 @@
 #include <vector>
 
 #include "linear.hpp"
+#include "tpetra_rows.hpp"
 
 namespace sp {
 
@@ -55,85 +54,11 @@ void ensure_kokkos() {
 
 namespace {
 
-using GO = long long;  // Debian 13.2 instantiates Tpetra for GO = long long only
-using Map = Tpetra::Map<int, GO>;
-using Graph = Tpetra::CrsGraph<int, GO>;
-using Matrix = Tpetra::CrsMatrix<double, int, GO>;
+using GO = TpetraRows::GO;
 using RowMatrix = Tpetra::RowMatrix<double, int, GO>;
-using MV = Tpetra::MultiVector<double, int, GO>;
+using MV = TpetraRows::MV;
 using OP = Tpetra::Operator<double, int, GO>;
 using Prec = Ifpack2::Preconditioner<double, int, GO>;
-
-// A Tpetra copy of CsrRows: its graph built once (rows contiguous in rank
-// order, as given); set_values() overwrites the values in place.
-class TpetraRows {
- public:
-  TpetraRows(const Teuchos::RCP<const Teuchos::Comm<int>> &comm, const CsrRows &A)
-      : n_global_(A.n_global), n_rows_(A.n_rows), nnz_(A.row_ptr[A.n_rows]) {
-    // (global size, local size): rows numbered contiguously in rank order
-    map_ = Teuchos::rcp(new Map((Tpetra::global_size_t)A.n_global, (size_t)A.n_rows, 0, comm));
-    if (A.n_rows > 0 && map_->getMinGlobalIndex() != A.first_row)
-      throw std::logic_error("Tpetra copy: rows are not contiguous in rank order");
-    std::vector<size_t> lengths(A.n_rows);
-    for (int i = 0; i < A.n_rows; ++i) lengths[i] = A.row_ptr[i + 1] - A.row_ptr[i];
-    auto graph = Teuchos::rcp(new Graph(map_, Teuchos::ArrayView<const size_t>(lengths)));
-    std::vector<GO> cols;
-    for (int i = 0; i < A.n_rows; ++i) {
-      cols.assign(A.col + A.row_ptr[i], A.col + A.row_ptr[i + 1]);
-      graph->insertGlobalIndices(A.first_row + i, Teuchos::ArrayView<const GO>(cols));
-    }
-    graph->fillComplete();
-    matrix_ = Teuchos::rcp(new Matrix(graph));
-    matrix_->fillComplete();
-    // slot_[k]: entry k of the caller's rows in the matrix's value array
-    const auto local = matrix_->getLocalMatrixHost();
-    const auto &colmap = *matrix_->getColMap();
-    slot_.resize(nnz_);
-    std::vector<std::pair<GO, size_t>> gid_pos;
-    for (int i = 0; i < A.n_rows; ++i) {
-      const size_t begin = local.graph.row_map(i), end = local.graph.row_map(i + 1);
-      gid_pos.clear();
-      for (size_t p = begin; p < end; ++p)
-        gid_pos.emplace_back(colmap.getGlobalElement(local.graph.entries(p)), p);
-      std::sort(gid_pos.begin(), gid_pos.end());
-      for (int k = A.row_ptr[i]; k < A.row_ptr[i + 1]; ++k) {
-        const auto key = std::make_pair((GO)A.col[k], (size_t)0);
-        auto it = std::lower_bound(gid_pos.begin(), gid_pos.end(), key);
-        if (it == gid_pos.end() || it->first != A.col[k])
-          throw std::logic_error("Tpetra copy: entry missing from the matrix");
-        slot_[k] = it->second;
-      }
-    }
-    lhs_ = Teuchos::rcp(new MV(map_, 1));
-    rhs_ = Teuchos::rcp(new MV(map_, 1));
-  }
-  // A has this pattern: same rows on this rank, same number of entries
-  // (the caller says whether the pattern is the same; this guards sizes).
-  bool same_pattern(const CsrRows &A) const {
-    return A.n_global == n_global_ && A.n_rows == n_rows_ && A.row_ptr[A.n_rows] == nnz_;
-  }
-  void set_values(const CsrRows &A) {
-    matrix_->resumeFill();
-    {
-      auto values = matrix_->getLocalMatrixHost().values;
-      for (size_t k = 0; k < slot_.size(); ++k) values(slot_[k]) = A.val[k];
-    }
-    auto params = Teuchos::rcp(new Teuchos::ParameterList);
-    params->set("No Nonlocal Changes", true);  // the graph is fixed: no communication
-    matrix_->fillComplete(matrix_->getDomainMap(), matrix_->getRangeMap(), params);
-  }
-  Teuchos::RCP<Matrix> matrix() const { return matrix_; }
-  Teuchos::RCP<MV> lhs() const { return lhs_; }
-  Teuchos::RCP<MV> rhs() const { return rhs_; }
-  int n_local() const { return n_rows_; }
-
- private:
-  int n_global_, n_rows_, nnz_;
-  Teuchos::RCP<const Map> map_;
-  Teuchos::RCP<Matrix> matrix_;
-  Teuchos::RCP<MV> lhs_, rhs_;
-  std::vector<size_t> slot_;
-};
 
 class KrylovSolver final : public DirectSolver {
  public:

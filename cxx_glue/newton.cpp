@@ -1,6 +1,8 @@
 #include "newton.hpp"
 
-#include <Epetra_Import.h>
+#include <Epetra_Map.h>
+#include <Epetra_MpiComm.h>
+#include <Epetra_Vector.h>
 #include <NOX.H>
 #include <NOX_Epetra_Group.H>
 #include <NOX_Epetra_Interface_Jacobian.H>
@@ -13,6 +15,9 @@
 #include <NOX_StatusTest_FiniteValue.H>
 #include <NOX_StatusTest_MaxIters.H>
 #include <NOX_StatusTest_NormF.H>
+#include <Teuchos_ParameterList.hpp>
+#include <Tpetra_CrsMatrix.hpp>
+#include <Tpetra_Vector.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -35,17 +40,20 @@ double now() {
 
 // NOX's callbacks: residual and Jacobian of the current step's equations.
 // Built once per layout with the group; Solver::step points it at its
-// sp_step_data for the length of the step (Scope).
+// sp_step_data for the length of the step (Scope). NOX's Epetra vectors and
+// the assembly's Tpetra objects have the same rows in the same local order
+// (Assembly::my_rows()): Solver copies the local arrays across.
 class StepInterface : public NOX::Epetra::Interface::Required,
                       public NOX::Epetra::Interface::Jacobian {
  public:
   explicit StepInterface(Solver &s) : s_(s) {}
   bool computeF(const Epetra_Vector &x, Epetra_Vector &F, FillType) override {
-    s_.fill_residual(data(), x, F);
+    s_.fill_residual(data(), x.Values(), F.Values());
     return true;
   }
-  bool computeJacobian(const Epetra_Vector &x, Epetra_Operator &) override {
-    s_.fill_jacobian(data(), x);
+  bool computeJacobian(const Epetra_Vector &x, Epetra_Operator &) override { return jacobian(x); }
+  bool jacobian(const Epetra_Vector &x) {
+    s_.fill_jacobian(data(), x.Values());
     return true;
   }
   // Points the callbacks at d until the scope ends.
@@ -70,20 +78,24 @@ class StepInterface : public NOX::Epetra::Interface::Required,
 };
 
 // NOX's hook for a direct solver: J is assembled by StepInterface and
-// factored here; there is no preconditioner.
+// factored here; there is no preconditioner. J is a Tpetra matrix, which
+// NOX::Epetra does not see: getJacobianOperator() gives none, and NOX
+// hands that back to setJacobianOperatorForSolve(), which ignores it.
 class DirectLinearSystem : public NOX::Epetra::LinearSystem {
  public:
   DirectLinearSystem(Solver &s, StepInterface &i) : s_(s), i_(i) {}
   bool applyJacobian(const NOX::Epetra::Vector &in, NOX::Epetra::Vector &out) const override {
-    return s_.apply_jacobian(in.getEpetraVector(), out.getEpetraVector(), false);
+    return s_.apply_jacobian(in.getEpetraVector().Values(), out.getEpetraVector().Values(),
+                             false);
   }
   bool applyJacobianTranspose(const NOX::Epetra::Vector &in,
                               NOX::Epetra::Vector &out) const override {
-    return s_.apply_jacobian(in.getEpetraVector(), out.getEpetraVector(), true);
+    return s_.apply_jacobian(in.getEpetraVector().Values(), out.getEpetraVector().Values(),
+                             true);
   }
   bool applyJacobianInverse(Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
                             NOX::Epetra::Vector &out) override {
-    return s_.solve_linear(in.getEpetraVector(), out.getEpetraVector());
+    return s_.solve_linear(in.getEpetraVector().Values(), out.getEpetraVector().Values());
   }
   bool applyRightPreconditioning(bool, Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
                                  NOX::Epetra::Vector &out) const override {
@@ -94,7 +106,7 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   void resetScaling(const Teuchos::RCP<NOX::Epetra::Scaling> &) override {}
   bool computeJacobian(const NOX::Epetra::Vector &x) override {
     if (s_.may_reuse_jacobian()) return true;  // keep matrix and factors
-    return i_.computeJacobian(x.getEpetraVector(), *s_.jacobian_operator());
+    return i_.jacobian(x.getEpetraVector());
   }
   bool createPreconditioner(const NOX::Epetra::Vector &, Teuchos::ParameterList &,
                             bool) const override { return false; }
@@ -105,9 +117,9 @@ class DirectLinearSystem : public NOX::Epetra::LinearSystem {
   bool isPreconditionerConstructed() const override { return false; }
   bool hasPreconditioner() const override { return false; }
   Teuchos::RCP<const Epetra_Operator> getJacobianOperator() const override {
-    return s_.jacobian_operator();
+    return Teuchos::null;
   }
-  Teuchos::RCP<Epetra_Operator> getJacobianOperator() override { return s_.jacobian_operator(); }
+  Teuchos::RCP<Epetra_Operator> getJacobianOperator() override { return Teuchos::null; }
   Teuchos::RCP<const Epetra_Operator> getGeneratedPrecOperator() const override {
     return Teuchos::null;
   }
@@ -271,7 +283,10 @@ struct Solver::Nox {
   Teuchos::RCP<UpdateSmall> update;           // the step's update tolerances
   Teuchos::RCP<RelativeDivergence> diverged;  // null: newton_divergence off
   int max_its = 0;
-  // Once per layout (set_problem): vectors on the layout's map.
+  std::unique_ptr<Epetra_MpiComm> comm;  // NOX::Epetra's vectors' communicator
+  // Once per layout (set_problem): vectors on the layout's rows (an Epetra
+  // map of Assembly::my_rows()).
+  std::unique_ptr<Epetra_Map> map;
   Teuchos::RCP<StepInterface> iface;
   Teuchos::RCP<NOX::Epetra::Vector> guess;
   Teuchos::RCP<NOX::Epetra::Group> group;
@@ -282,6 +297,8 @@ Solver::~Solver() = default;
 
 Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     : comm_(comm), options_(options) {
+  check_mpi(MPI_Comm_rank(comm, &rank_), "MPI_Comm_rank");
+  check_mpi(MPI_Comm_size(comm, &n_ranks_), "MPI_Comm_size");
   if (options.jacobian < SP_SOLVER_JAC_AD || options.jacobian > SP_SOLVER_JAC_FD)
     throw input_error("solver.jacobian: unknown kind");
   if (!(options.jacobian_reuse >= 0 && options.jacobian_reuse < 1))
@@ -294,13 +311,13 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     throw input_error("solver.line_search: unknown kind");
   if (!(options.newton_divergence == 0 || options.newton_divergence > 1))
     throw input_error("solver.newton_divergence: expected 0 (off) or a value > 1");
-  const int P = comm_.NumProc();
+  const int P = n_ranks_;
   std::unique_ptr<DirectSolver> direct;
   switch (options.linear) {
     case SP_SOLVER_SUPERLU:
       // Serial SuperLU under MPI: the matrix is gathered on rank 0.
       direct = P == 1 ? make_superlu()
-                       : make_gathered(comm, comm_.MyPID() == 0 ? make_superlu() : nullptr);
+                       : make_gathered(comm, rank_ == 0 ? make_superlu() : nullptr);
       break;
     case SP_SOLVER_SUPERLU_DIST:
       direct = make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS,
@@ -308,7 +325,7 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       break;
     case SP_SOLVER_MUMPS: direct = make_mumps(comm); break;
     case SP_SOLVER_KLU:  // serial KLU under MPI: gathered on rank 0, as SuperLU
-      direct = P == 1 ? make_klu() : make_gathered(comm, comm_.MyPID() == 0 ? make_klu() : nullptr);
+      direct = P == 1 ? make_klu() : make_gathered(comm, rank_ == 0 ? make_klu() : nullptr);
       break;
     case SP_SOLVER_KLU2:
       // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
@@ -342,6 +359,7 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
   linear_ = std::make_unique<LowRankSolver>(comm, std::move(direct));
 
   nox_ = std::make_unique<Nox>();
+  nox_->comm = std::make_unique<Epetra_MpiComm>(comm);
   auto params = Teuchos::rcp(new Teuchos::ParameterList);
   params->set("Nonlinear Solver", "Line Search Based");
   // Backtrack: NOX's defaults (halve the step until the sum of squares of
@@ -377,7 +395,7 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
   tolerance->addStatusTest(Teuchos::rcp(new NormF(options_.newton_atol, NormF::Unscaled)));
   nox_->relative = Teuchos::rcp(new NormF(0.0, NormF::Unscaled));
   tolerance->addStatusTest(nox_->relative);
-  nox_->update = Teuchos::rcp(new UpdateSmall(comm_.Comm()));
+  nox_->update = Teuchos::rcp(new UpdateSmall(comm_));
   tolerance->addStatusTest(nox_->update);
   converged->addStatusTest(tolerance);
   converged->addStatusTest(Teuchos::rcp(new AtLeastOneIteration));
@@ -404,7 +422,10 @@ void Solver::build_nox_solve() {
   n.solver = Teuchos::null;  // (it holds the old group)
   n.iface = Teuchos::rcp(new StepInterface(*this));
   auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *n.iface));
-  n.guess = Teuchos::rcp(new NOX::Epetra::Vector(Epetra_Vector(assembly_->map())));
+  const std::vector<GlobalId> &rows = assembly_->my_rows();
+  const std::vector<int> ids(rows.begin(), rows.end());  // (n_dofs < 2^31: Epetra's int ids)
+  n.map = std::make_unique<Epetra_Map>(-1, (int)ids.size(), ids.data(), 0, *n.comm);
+  n.guess = Teuchos::rcp(new NOX::Epetra::Vector(Epetra_Vector(*n.map)));
   n.group = Teuchos::rcp(
       new NOX::Epetra::Group(n.params->sublist("Printing"), n.iface, *n.guess, linsys));
   // (evaluates nothing: F is first computed in step)
@@ -417,65 +438,69 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   // The CSR rows handed to the direct solver: this rank's rows, global
   // column indices. The backends need each rank's rows contiguous and the
   // blocks in rank order (the node partition of Assembly gives that).
-  const Epetra_CrsGraph &g = assembly_->graph();
-  const int n = g.NumMyRows();
+  const TpetraGraph &g = *assembly_->graph();
+  const std::vector<GlobalId> &rows = assembly_->my_rows();
+  const int n = (int)rows.size();
   agree_local(comm_, [&] {  // (the gathers below are collective)
-    jacobian_matrix_ = Teuchos::rcp(new Epetra_FECrsMatrix(Copy, assembly_->graph()));
+    jacobian_matrix_ = Teuchos::rcp(new TpetraMatrix(assembly_->graph()));
+    jacobian_matrix_->fillComplete(assembly_->map(), assembly_->map());
+    residual_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
+    apply_in_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
+    apply_out_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
     build_nox_solve();
-    first_row_ = n > 0 ? g.RowMap().GID(0) : 0;
+    first_row_ = n > 0 ? (int)rows[0] : 0;
     for (int i = 0; i < n; ++i)
-      if (g.RowMap().GID(i) != first_row_ + i)
-        throw std::logic_error("the rows of a rank are not contiguous");
+      if (rows[i] != first_row_ + i) throw std::logic_error("the rows of a rank are not contiguous");
   });
-  const int P = comm_.NumProc();
+  const int P = n_ranks_;
   std::vector<int> firsts(P), counts(P);
-  MPI_Allgather(&first_row_, 1, MPI_INT, firsts.data(), 1, MPI_INT, comm_.Comm());
-  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_.Comm());
+  MPI_Allgather(&first_row_, 1, MPI_INT, firsts.data(), 1, MPI_INT, comm_);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
   for (int r = 0, next = 0; r < P; next += counts[r], ++r)
     if (counts[r] > 0 && firsts[r] != next)
       throw std::logic_error("the row blocks of the ranks are not in rank order");
   first_row_ = 0;  // (also right for a rank without rows)
-  for (int r = 0; r < comm_.MyPID(); ++r) first_row_ += counts[r];
-  n_global_ = g.NumGlobalRows();
-  // On one process the column map is the row map and Epetra keeps each
-  // row sorted by local index, so its arrays are the sorted rows already: a
-  // backend that only reads them reads the Jacobian's own storage, and no
-  // copy is made.
+  for (int r = 0; r < rank_; ++r) first_row_ += counts[r];
+  n_global_ = (int)g.getGlobalNumRows();
+  // On one process the column map is the row map (Assembly) and each row
+  // is sorted by local column, so the local arrays are the sorted rows
+  // already: a backend that only reads them reads the Jacobian's own
+  // columns and values (its row offsets are size_t: an int copy is kept).
+  const auto local = g.getLocalGraphHost();
+  const auto &cols = *g.getColMap();
   rows_in_place_ = P == 1 && !linear_->overwrites_values() &&
-                   jacobian_matrix_->StorageOptimized() &&
-                   g.ColMap().NumMyElements() == n_global_;
-  for (int k = 0; rows_in_place_ && k < g.ColMap().NumMyElements(); ++k)
-    rows_in_place_ = g.ColMap().GID(k) == k;
-  for (int i = 0; rows_in_place_ && i < n; ++i) {  // (Epetra's Sorted() is not public)
-    int len, *idx;
-    g.ExtractMyRowView(i, len, idx);
-    for (int k = 1; rows_in_place_ && k < len; ++k) rows_in_place_ = idx[k - 1] < idx[k];
-  }
+                   (int)cols.getNodeNumElements() == n_global_;
+  for (int k = 0; rows_in_place_ && k < n_global_; ++k)
+    rows_in_place_ = cols.getGlobalElement(k) == k;
   // Else columns sorted by global index within each row: the same arrays
-  // for any number of ranks (Epetra orders a row by local column index,
-  // which depends on the partition, and orderings break ties by entry
-  // order). csr_from_[k]: the position in the Epetra row of sorted entry k.
+  // for any number of ranks (a row is ordered by local column index, which
+  // depends on the partition, and orderings break ties by entry order).
+  // csr_from_[k]: the position in the Tpetra row of sorted entry k.
   std::vector<int>().swap(csr_ptr_);
   std::vector<int>().swap(csr_col_);
   std::vector<int>().swap(csr_from_);
   std::vector<double>().swap(csr_val_);
-  if (!rows_in_place_) {
-    csr_ptr_.assign(1, 0);
-    std::vector<std::pair<int, int>> row;
-    for (int i = 0; i < n; ++i) {
-      int len, *idx;
-      g.ExtractMyRowView(i, len, idx);
-      row.resize(len);
-      for (int k = 0; k < len; ++k) row[k] = {g.ColMap().GID(idx[k]), k};
-      std::sort(row.begin(), row.end());
-      for (const auto &e : row) {
-        csr_col_.push_back(e.first);
-        csr_from_.push_back(e.second);
-      }
-      csr_ptr_.push_back((int)csr_col_.size());
+  csr_ptr_.assign(1, 0);
+  std::vector<std::pair<int, int>> row;
+  for (int i = 0; i < n; ++i) {
+    const size_t begin = local.row_map(i), end = local.row_map(i + 1);
+    if (rows_in_place_) {
+      for (size_t k = begin + 1; k < end; ++k)
+        if (local.entries(k - 1) >= local.entries(k)) throw std::logic_error("a row is not sorted");
+      csr_ptr_.push_back((int)end);
+      continue;
     }
-    csr_val_.assign(csr_col_.size(), 0.0);
+    row.resize(end - begin);
+    for (size_t k = begin; k < end; ++k)
+      row[k - begin] = {(int)cols.getGlobalElement(local.entries(k)), (int)(k - begin)};
+    std::sort(row.begin(), row.end());
+    for (const auto &e : row) {
+      csr_col_.push_back(e.first);
+      csr_from_.push_back(e.second);
+    }
+    csr_ptr_.push_back((int)csr_col_.size());
   }
+  csr_val_.assign(csr_col_.size(), 0.0);
   pattern_changed_ = true;
   jacobian_fresh_ = false;
 }
@@ -484,26 +509,46 @@ void Solver::require_problem() const {
   if (!assembly_) throw std::runtime_error("sp_solver_set_problem was not called");
 }
 
-void Solver::gather(const Epetra_Vector &x, std::vector<double> &full) const {
+void Solver::gather(const double *x, std::vector<double> &full) const {
   // Each rank owns a contiguous DOF range in rank order: an allgather.
-  const int P = comm_.NumProc();
+  const int P = n_ranks_;
   std::vector<int> counts(P), displs(P, 0);
-  int mine = x.MyLength();
-  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_.Comm());
+  int mine = (int)assembly_->my_rows().size();
+  MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
   for (int r = 1; r < P; ++r) displs[r] = displs[r - 1] + counts[r - 1];
   full.resize(assembly_->n_dofs());
-  MPI_Allgatherv(x.Values(), mine, MPI_DOUBLE, full.data(), counts.data(), displs.data(),
-                 MPI_DOUBLE, comm_.Comm());
+  MPI_Allgatherv(x, mine, MPI_DOUBLE, full.data(), counts.data(), displs.data(), MPI_DOUBLE,
+                 comm_);
 }
 
-void Solver::fill_residual(const sp_step_data &d, const Epetra_Vector &x, Epetra_Vector &F) {
+void Solver::scatter(const double *x, double *mine) const {
+  const std::vector<GlobalId> &rows = assembly_->my_rows();
+  for (size_t i = 0; i < rows.size(); ++i) mine[i] = x[rows[i]];
+}
+
+namespace {
+
+// The local array of a Tpetra vector to or from a plain one (this rank's rows).
+void copy_from(const TpetraVector &v, double *out) {
+  const auto view = v.getLocalViewHost(Tpetra::Access::ReadOnly);
+  for (size_t i = 0; i < view.extent(0); ++i) out[i] = view(i, 0);
+}
+void copy_into(const double *in, TpetraVector &v) {
+  const auto view = v.getLocalViewHost(Tpetra::Access::OverwriteAll);
+  for (size_t i = 0; i < view.extent(0); ++i) view(i, 0) = in[i];
+}
+
+}  // namespace
+
+void Solver::fill_residual(const sp_step_data &d, const double *x, double *F) {
   double t0 = now();
   gather(x, full_);
-  assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), F);
+  assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), *residual_);
+  copy_from(*residual_, F);
   t_assembly_ += now() - t0;
 }
 
-void Solver::fill_jacobian(const sp_step_data &d, const Epetra_Vector &x) {
+void Solver::fill_jacobian(const sp_step_data &d, const double *x) {
   double t0 = now();
   gather(x, full_);
   // The element Jacobians take the shape coefficients as constants; their
@@ -526,29 +571,26 @@ void Solver::prepare_shape(const sp_step_data &d) {
   linear_->set_term(shape_.jacobian_term(*assembly_));
 }
 
-bool Solver::apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out, bool transpose) {
-  jacobian_matrix_->SetUseTranspose(transpose);
-  const bool ok = jacobian_matrix_->Apply(in, out) == 0;
-  jacobian_matrix_->SetUseTranspose(false);
-  if (!ok) return false;
-  linear_->term().add_apply(comm_.Comm(), in.Values(), out.Values(), transpose);
+bool Solver::apply_jacobian(const double *in, double *out, bool transpose) {
+  copy_into(in, *apply_in_);
+  jacobian_matrix_->apply(*apply_in_, *apply_out_, transpose ? Teuchos::TRANS : Teuchos::NO_TRANS);
+  copy_from(*apply_out_, out);
+  linear_->term().add_apply(comm_, in, out, transpose);
   return true;
 }
 
 void Solver::jacobian_times(const sp_step_data &d, const double *state, bool transpose,
                             const double *x, double *y) {
   require_problem();
-  const Epetra_Map &map = assembly_->map();
-  Epetra_Vector at(map), in(map), out(map);
-  for (int i = 0; i < map.NumMyElements(); ++i) {
-    at[i] = state[map.GID(i)];
-    in[i] = x[map.GID(i)];
-  }
+  const size_t n = assembly_->my_rows().size();
+  std::vector<double> at(n), in(n), out(n);
+  scatter(state, at.data());
+  scatter(x, in.data());
   prepare_shape(d);
-  fill_jacobian(d, at);
-  if (!apply_jacobian(in, out, transpose)) throw std::runtime_error("Jacobian: Apply failed");
+  fill_jacobian(d, at.data());
+  apply_jacobian(in.data(), out.data(), transpose);
   std::vector<double> full;
-  gather(out, full);
+  gather(out.data(), full);
   std::copy(full.begin(), full.end(), y);
 }
 
@@ -564,11 +606,10 @@ bool Solver::carry_point(double &dt, const std::vector<double> *&x,
 void Solver::carry_restore(const sp_step_data &d, const double *x) {
   require_problem();
   if (!carries()) return;  // (a continued run with the carry switched off: nothing to carry)
-  const Epetra_Map &map = assembly_->map();
-  Epetra_Vector xv(map);
-  for (int i = 0; i < map.NumMyElements(); ++i) xv[i] = x[map.GID(i)];
+  std::vector<double> mine(assembly_->my_rows().size());
+  scatter(x, mine.data());
   prepare_shape(d);
-  fill_jacobian(d, xv);
+  fill_jacobian(d, mine.data());
   std::string why;
   if (!factor_jacobian(why))  // (agreed inside)
     throw std::runtime_error("rebuilding the carried factorisation: " + why);
@@ -592,25 +633,21 @@ bool Solver::may_reuse_jacobian() const {
 
 bool Solver::factor_jacobian(std::string &why) {
   double t0 = now();
-  const int n = jacobian_matrix_->NumMyRows();
+  const int n = (int)assembly_->my_rows().size();
   CsrRows A;
   A.n_global = n_global_;
   A.first_row = first_row_;
   A.n_rows = n;
+  const auto local = jacobian_matrix_->getLocalMatrixHost();
   if (rows_in_place_) {
-    int *offsets, *cols;
-    double *vals;
-    if (jacobian_matrix_->ExtractCrsDataPointers(offsets, cols, vals) != 0)
-      throw std::logic_error("the Jacobian's storage is not contiguous");
-    A.row_ptr = offsets;
-    A.col = cols;
-    A.val = vals;
+    A.row_ptr = csr_ptr_.data();
+    A.col = local.graph.entries.data();
+    A.val = local.values.data();
   } else {
+    const double *vals = local.values.data();
     for (int i = 0; i < n; ++i) {
-      int len;
-      double *vals;
-      jacobian_matrix_->ExtractMyRowView(i, len, vals);
-      for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = vals[csr_from_[k]];
+      const double *row = vals + local.graph.row_map(i);
+      for (int k = csr_ptr_[i]; k < csr_ptr_[i + 1]; ++k) csr_val_[k] = row[csr_from_[k]];
     }
     A.row_ptr = csr_ptr_.data();
     A.col = csr_col_.data();
@@ -618,7 +655,7 @@ bool Solver::factor_jacobian(std::string &why) {
   }
   linear_->set_rhs_count(1);
   bool ok = linear_->factor(A, !pattern_changed_, why);
-  ok = all_agree(comm_.Comm(), ok, why);
+  ok = all_agree(comm_, ok, why);
   t_factor_ += now() - t0;
   if (!ok) {
     pattern_changed_ = true;  // start the next factorisation from scratch
@@ -630,7 +667,7 @@ bool Solver::factor_jacobian(std::string &why) {
   return true;
 }
 
-bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x) {
+bool Solver::solve_linear(const double *b, double *x) {
   std::string why;
   const bool fresh = jacobian_fresh_;
   if (fresh && !factor_jacobian(why)) {
@@ -640,7 +677,7 @@ bool Solver::solve_linear(const Epetra_Vector &b, Epetra_Vector &x) {
   // (the first solve after a factorisation also does the low-rank term's
   // block solve and small factorisation: counted as solve time)
   double t0 = now();
-  bool ok = linear_->solve(b.Values(), x.Values(), why);
+  bool ok = linear_->solve(b, x, why);
   t_solve_ += now() - t0;
   if (!ok && fresh) jacobian_fresh_ = true;  // refactor before the next solve
   if (!ok) linear_failure_ = why;
@@ -661,9 +698,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   const long linear_its_before = linear_->iterations();
   Nox &n = *nox_;
   const StepInterface::Scope scope(*n.iface, d);
-  Epetra_Vector &x0 = n.guess->getEpetraVector();
-  const Epetra_Map &map = assembly_->map();
-  for (int i = 0; i < map.NumMyElements(); ++i) x0[i] = state[map.GID(i)];
+  scatter(state, n.guess->getEpetraVector().Values());
 
   prepare_shape(d);
   // Carry the last step's factorisation: same layout, the last step
@@ -709,7 +744,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   if (status == Converged) {
     const auto &xs = dynamic_cast<const NOX::Epetra::Vector &>(
         n.solver->getSolutionGroup().getX()).getEpetraVector();
-    gather(xs, full_);
+    gather(xs.Values(), full_);
     std::copy(full_.begin(), full_.end(), state);
     report.converged = 1;
     last_converged_ = true;
@@ -753,11 +788,12 @@ sp_energy_parts Solver::energy(const sp_model_params &m, const double *state) co
 
 void Solver::residual(const sp_step_data &d, const double *state, double *out) {
   require_problem();
-  Epetra_Vector F(assembly_->map());
+  TpetraVector F(assembly_->map());
   shape_.prepare(d, *assembly_);
   assembly_->residual(shape_.data_at(d, *assembly_, state), state, F);
-  std::vector<double> full;
-  gather(F, full);
+  std::vector<double> mine(assembly_->my_rows().size()), full;
+  copy_from(F, mine.data());
+  gather(mine.data(), full);
   std::copy(full.begin(), full.end(), out);
 }
 
@@ -776,7 +812,8 @@ double Solver::time_jacobian(const sp_step_data &d, const double *state, int kin
                              int repeats, double *elements) const {
   require_problem();
   if (repeats < 1) throw std::invalid_argument("time_jacobian: repeats must be >= 1");
-  Epetra_FECrsMatrix J(Copy, assembly_->graph());
+  TpetraMatrix J(assembly_->graph());
+  J.fillComplete(assembly_->map(), assembly_->map());
   double t0 = now();
   for (int r = 0; r < repeats; ++r) assembly_->jacobian(d, state, kind, J);
   const double fill = (now() - t0) / repeats;

@@ -8,8 +8,7 @@
 #ifndef SP_NEWTON_HPP
 #define SP_NEWTON_HPP
 
-#include <Epetra_FECrsMatrix.h>
-#include <Epetra_MpiComm.h>
+#include <mpi.h>
 #include <Teuchos_RCP.hpp>
 
 #include <memory>
@@ -40,7 +39,7 @@ class Solver {
   /// Fill the Jacobian at x with d and factor it: the next step may begin
   /// on it, as in the run whose carry_point this is.
   void carry_restore(const sp_step_data &d, const double *x);
-  int ranks() const { return comm_.NumProc(); }
+  int ranks() const { return n_ranks_; }
   // Returns 0 when converged, 1 when Newton failed (state untouched).
   int step(const sp_step_data &data, double *state, sp_step_report &report);
   sp_energy_parts energy(const sp_model_params &m, const double *state) const;
@@ -54,17 +53,17 @@ class Solver {
   double time_jacobian(const sp_step_data &data, const double *state, int kind,
                        int repeats, double *elements) const;
 
-  // Called by the NOX interface and linear system (newton.cpp).
-  void fill_residual(const sp_step_data &data, const Epetra_Vector &x, Epetra_Vector &F);
-  void fill_jacobian(const sp_step_data &data, const Epetra_Vector &x);
+  // Called by the NOX interface and linear system (newton.cpp), on this
+  // rank's rows (Assembly::my_rows(), in that order): NOX's vectors' local
+  // arrays, copied into and out of the Tpetra objects.
+  void fill_residual(const sp_step_data &data, const double *x, double *F);
+  void fill_jacobian(const sp_step_data &data, const double *x);
   // Solves J x = b (factoring J first if it changed); false: the reason is
   // kept for the step's report (a failed linear solve fails the attempt).
-  bool solve_linear(const Epetra_Vector &b, Epetra_Vector &x);
-  // The sparse part of J, the operator NOX's linear system hands out.
-  const Teuchos::RCP<Epetra_FECrsMatrix> &jacobian_operator() const { return jacobian_matrix_; }
+  bool solve_linear(const double *b, double *x);
   // out = J in (or J^T in), J the sparse matrix plus the implicit shape
   // term's low-rank part.
-  bool apply_jacobian(const Epetra_Vector &in, Epetra_Vector &out, bool transpose);
+  bool apply_jacobian(const double *in, double *out, bool transpose);
   // The Jacobian of the step equations at state applied to x (or its
   // transpose): a test hook (sp_solver_apply_jacobian); full vectors.
   void jacobian_times(const sp_step_data &data, const double *state, bool transpose,
@@ -90,29 +89,35 @@ class Solver {
   // A step's implicit shape term: its coefficients (shape_) and its
   // Jacobian part, handed to the linear solver.
   void prepare_shape(const sp_step_data &data);
-  // The full (replicated) state from a distributed vector.
-  void gather(const Epetra_Vector &x, std::vector<double> &full) const;
+  // The full (replicated) state from this rank's rows of a vector.
+  void gather(const double *mine, std::vector<double> &full) const;
+  // This rank's rows of the full vector x.
+  void scatter(const double *x, double *mine) const;
 
-  // The sparse part of J (declared first, so destroyed last).
-  Teuchos::RCP<Epetra_FECrsMatrix> jacobian_matrix_;
+  // The sparse part of J (declared first, so destroyed last), and vectors
+  // on its rows: the residual, Apply's input and output.
+  Teuchos::RCP<TpetraMatrix> jacobian_matrix_;
+  Teuchos::RCP<TpetraVector> residual_, apply_in_, apply_out_;
   // Why the current step's last linear solve failed (empty: none did).
   std::string linear_failure_;
   // Seconds of the current step: residual and Jacobian fills,
   // factorisations, solves (sp_step_report).
   double t_assembly_ = 0, t_factor_ = 0, t_solve_ = 0;
-  Epetra_MpiComm comm_;
+  MPI_Comm comm_;
+  int rank_ = 0, n_ranks_ = 1;
   sp_solver_options options_;
   std::unique_ptr<Assembly> assembly_;
   // The backend of solver.linear inside the low-rank (Woodbury) wrapper.
   std::unique_ptr<LowRankSolver> linear_;
   std::unique_ptr<Nox> nox_;
   std::vector<int> csr_ptr_, csr_col_;  // this rank's rows: pattern, global columns (sorted)
-  std::vector<int> csr_from_;           // position of each entry in its Epetra row
+  std::vector<int> csr_from_;           // position of each entry in its Tpetra row
   int first_row_ = 0, n_global_ = 0;    // the rows are first_row_ .. + n_rows - 1
   std::vector<double> csr_val_;
-  // One process, a backend that only reads, and Epetra's rows already in
-  // the sorted order: the backend reads the Jacobian's own arrays and the
-  // csr_* copies are not kept (the values exist once, docs/design.md).
+  // One process, a backend that only reads, and Tpetra's rows already in
+  // the sorted order: the backend reads the Jacobian's own column and value
+  // arrays (csr_ptr_ holds its row offsets as int) and no copy of the
+  // values is kept (the values exist once, docs/design.md).
   bool rows_in_place_ = false;
   bool jacobian_fresh_ = false;  // the matrix changed since the last factor
   bool pattern_changed_ = true;  // the layout changed since the last factor

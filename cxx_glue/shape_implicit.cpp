@@ -69,9 +69,8 @@ LowRankTerm ImplicitShape::jacobian_term(const Assembly &assembly) const {
       for (int j = 0; j < n; ++j)
         term.c[(size_t)(n * a + i) * m + n * a + j] = -gain_[(size_t)n * n * a + n * i + j];
   // row g = 2p + f of pair p: field f = 0 (c) belongs to V, f = 1 (mu) to U
-  const Epetra_Map &map = assembly.map();
-  for (int r = 0; r < map.NumMyElements(); ++r) {
-    const int g = map.GID(r), p = g / 2, f = g % 2;
+  for (const GlobalId row : assembly.my_rows()) {
+    const int g = (int)row, p = g / 2, f = g % 2;
     const int a = active_of_cell_[assembly.pair_cell(p)];
     std::vector<int> &ptr = f ? term.u_ptr : term.v_ptr, &col = f ? term.u_col : term.v_col;
     std::vector<double> &val = f ? term.u_val : term.v_val;

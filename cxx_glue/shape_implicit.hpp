@@ -27,8 +27,8 @@ class ImplicitShape {
   // data itself when there is no implicit term.
   const sp_step_data &data_at(const sp_step_data &data, const Assembly &assembly,
                               const double *state);
-  // The Jacobian's low-rank part U C V^T on this rank's rows of
-  // assembly.map(): U's columns n a + i are u_i of active cell a on its mu
+  // The Jacobian's low-rank part U C V^T on this rank's rows
+  // (assembly.my_rows()): U's columns n a + i are u_i of active cell a on its mu
   // rows, V's the same on its c rows, C_a = -gain (n x n; R_mu holds
   // +coef_i u_i, and coef_i falls by gain[i][j] dI_j). Empty without one.
   LowRankTerm jacobian_term(const Assembly &assembly) const;

@@ -27,11 +27,14 @@ for pkg in AztecOO:aztecoo Ifpack:ifpack ML:ml "Amesos (v1):amesos"; do
     echo "gone: $name ($file not directly needed)"
   fi
 done
-# still linked, to go (issue 31): Epetra, EpetraExt, NOX's Epetra adapters
+# still linked, to go (issue 31): Epetra, EpetraExt, NOX's Epetra
+# adapters. Since phase 1 the assembly is on Tpetra and Epetra holds only
+# NOX's vectors (cxx_glue/newton.cpp); phase 2 moves NOX to Thyra
+# (NOX::Thyra::Group over a ModelEvaluator on Tpetra) and drops them.
 for pkg in Epetra:epetra EpetraExt:epetraext NOX-Epetra:noxepetra; do
   name=${pkg%%:*} file=libtrilinos_${pkg##*:}.so
   if grep -q "^${file}\(\.\|$\)" <<< "$needed"; then
-    echo "still linked, to go: $name ($file)"
+    echo "still linked, to go: $name ($file; only NOX's vectors in newton.cpp, until NOX runs through Thyra)"
   else
     echo "gone: $name ($file not directly needed)"
   fi
