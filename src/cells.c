@@ -152,7 +152,7 @@ int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, d
   reference_shapes(mesh->dim, N);
   for (int i = 0; i < mesh->n_nodes; ++i) w[i] = 0.0;
   for (int e = 0; e < mesh->n_elems; ++e) {
-    const int *nodes = mesh->elem + (size_t)nen * e;
+    const int *nodes = sp_mesh_elem_nodes(mesh, e);
     int64_t s = t->elem_start[e]; /* slots by increasing cell */
     while (s < t->elem_start[e + 1] && t->slot_cell[s] < k) ++s;
     if (s == t->elem_start[e + 1] || t->slot_cell[s] != k) continue;

@@ -689,7 +689,7 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l,
   sp_b64_begin_array(&b, f, (uint64_t)ne * nen * sizeof(int32_t));
   for (int j = 0; j < ne; ++j)
     for (int a = 0; a < nen; ++a) {
-      const int node = mesh->elem[(size_t)nen * part_elem(part, j) + a];
+      const int node = sp_mesh_elem_nodes(mesh, part_elem(part, j))[a];
       int32_t n = part->local ? part->local[node] : node;
       sp_b64_put(&b, &n, sizeof n);
     }
@@ -798,7 +798,7 @@ int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout
   for (size_t i = 0; i < nn; ++i) local[i] = -1;
   const int nen = mesh->nodes_per_elem;
   for (size_t e = 0; e < ne; ++e) {
-    const int *en = mesh->elem + (size_t)nen * e;
+    const int *en = sp_mesh_elem_nodes(mesh, e);
     if (en[0] < first_node || en[0] >= end_node) continue; /* the solver's rule */
     elems[n_elems++] = (int)e;
     for (int a = 0; a < nen; ++a) local[en[a]] = 0;

@@ -36,13 +36,13 @@ static int node_elements(struct sp_support_s *s) {
   const sp_mesh *mesh = s->mesh;
   const int nn = mesh->n_nodes, ne = mesh->n_elems, nen = mesh->nodes_per_elem;
   for (int e = 0; e < ne; ++e)
-    for (int a = 0; a < nen; ++a) ++s->ne_start[mesh->elem[(size_t)nen * e + a] + 1];
+    for (int a = 0; a < nen; ++a) ++s->ne_start[sp_mesh_elem_nodes(mesh, e)[a] + 1];
   for (int i = 0; i < nn; ++i) s->ne_start[i + 1] += s->ne_start[i];
   int *fill;
   SP_ALLOC(fill, nn);
   for (int e = 0; e < ne; ++e) {
     for (int a = 0; a < nen; ++a) {
-      int n = mesh->elem[(size_t)nen * e + a];
+      int n = sp_mesh_elem_nodes(mesh, e)[a];
       s->ne_list[s->ne_start[n] + fill[n]++] = e;
     }
   }
@@ -96,11 +96,6 @@ static double node_distance(const sp_mesh *m, int i, int j) {
   return r;
 }
 
-/** Element e's nodes (mesh->nodes_per_elem of them). */
-static const int *element_nodes(const sp_mesh *m, int e) {
-  return m->elem + (size_t)m->nodes_per_elem * e;
-}
-
 /**
  * Multi-source search from the n_seeds nodes in s->queue[0..n_seeds):
  * every node reachable through element neighbours whose straight distance
@@ -121,7 +116,7 @@ static int grow_from_seeds(sp_support s, int n_seeds, double radius,
   while (head < tail) {
     const int i = s->queue[head++];
     for (int t = s->ne_start[i]; t < s->ne_start[i + 1]; ++t) {
-      const int *nodes = element_nodes(m, s->ne_list[t]);
+      const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
       for (int a = 0; a < m->nodes_per_elem; ++a) {
         const int j = nodes[a];
         if (allowed && !allowed[j]) continue;
@@ -187,7 +182,7 @@ static int lists_push(cell_lists *L, int n_cells_done, int i) {
 
 /** Every node of element e is marked in s->member. */
 static int all_members(sp_support s, int e) {
-  const int *nodes = element_nodes(s->mesh, e);
+  const int *nodes = sp_mesh_elem_nodes(s->mesh, e);
   for (int a = 0; a < s->mesh->nodes_per_elem; ++a)
     if (!s->member[nodes[a]]) return 0;
   return 1;
@@ -206,7 +201,7 @@ static int close_to_elements(sp_support s, int n, int k, cell_lists *L) {
   for (int q = 0; q < n && rc == SP_OK; ++q)
     for (int t = s->ne_start[s->queue[q]]; t < s->ne_start[s->queue[q] + 1]; ++t) {
       if (!all_members(s, s->ne_list[t])) continue;
-      const int *nodes = element_nodes(m, s->ne_list[t]);
+      const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
       for (int a = 0; a < m->nodes_per_elem && rc == SP_OK; ++a)
         if (!s->kept[nodes[a]]) {
           s->kept[nodes[a]] = 1;
@@ -284,7 +279,7 @@ int sp_support_layout(sp_support s, const sp_layout *layout, const double *state
  *  whole for cell k. */
 static int on_edge(sp_support s, const sp_layout *layout, int k, int i) {
   for (int t = s->ne_start[i]; t < s->ne_start[i + 1]; ++t) {
-    const int *nodes = element_nodes(s->mesh, s->ne_list[t]);
+    const int *nodes = sp_mesh_elem_nodes(s->mesh, s->ne_list[t]);
     for (int a = 0; a < s->mesh->nodes_per_elem; ++a)
       if (sp_layout_pair(layout, k, nodes[a]) < 0) return 1;
   }
