@@ -926,7 +926,7 @@ static void *sp_vtu_array(const char *xml, const char *name, size_t *bytes) {
 }
 
 void sp_vtu_fields_free(sp_vtu_fields *v) {
-  free(v->xy);
+  free(v->xyz);
   free(v->c);
   free(v->mu);
   *v = (sp_vtu_fields){0};
@@ -965,15 +965,12 @@ int sp_vtu_read(const char *path, sp_vtu_fields *out) {
   if (rc == SP_OK) {
     out->n_points = n;
     out->n_cells = n_cells;
-    out->xy = malloc(sizeof(double) * 2 * (size_t)n + 1);
+    out->xyz = malloc(sizeof(double) * 3 * (size_t)n + 1);
     out->c = malloc(sizeof(double) * (size_t)n * n_cells + 1);
     out->mu = malloc(sizeof(double) * (size_t)n * n_cells + 1);
-    if (!out->xy || !out->c || !out->mu) rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
+    if (!out->xyz || !out->c || !out->mu) rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
   }
-  for (int i = 0; rc == SP_OK && i < n; ++i) {
-    out->xy[2 * i] = pts[3 * i];
-    out->xy[2 * i + 1] = pts[3 * i + 1];
-  }
+  if (rc == SP_OK) memcpy(out->xyz, pts, sizeof(double) * 3 * (size_t)n);
   for (int k = 0; rc == SP_OK && k < n_cells; ++k)
     for (int which = 0; rc == SP_OK && which < 2; ++which) {
       char name[32];

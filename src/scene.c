@@ -273,8 +273,7 @@ static const sp_key sp_keys[] = {
     /* mesh */
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
              "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
-             "or an ellipsoid of hexahedra (3D; not yet with initial fields from "
-             "initial.from: issue 29)"),
+             "or an ellipsoid of hexahedra (3D)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
               "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
@@ -1653,12 +1652,9 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
   return check_flatten_key(scene, file);
 }
 
-/** Why a 3D scene cannot have a feature yet (issue 29's later phases). */
-#define SP_NOT_YET_3D "not yet in 3D (mesh.type box, ellipsoid; issue 29)"
-
-/** What a scene on a 3D mesh cannot ask for yet, each refused naming its
- *  key, rather than run wrong: initial fields from files (initial.from);
- *  and on a 2D mesh, the third moment's shape.delta3. */
+/** What a scene of one dimension cannot ask for, each refused naming its
+ *  key: on a 3D mesh a PNG label image, on a 2D mesh the third moment's
+ *  shape.delta3. */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) {
     SP_CHECK(scene->shape.delta3 == 0, SP_ERR_INPUT,
@@ -1667,9 +1663,6 @@ static int check_3d(const sp_scene *scene, const char *file) {
              file, scene->shape.delta3);
     return SP_OK;
   }
-  SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
-           "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
-           ": expected none, got '%s'", file, scene->initial.from);
   SP_CHECK(scene->initial.label_image[0] == '\0', SP_ERR_INPUT,
            "%s: initial.label_image: a PNG label image is 2D: expected none on a 3D mesh "
            "(a 3D scene takes a NIfTI label volume, initial.label_volume), got '%s'", file,
