@@ -152,7 +152,7 @@ int sp_cells_node_weights(const sp_mesh *mesh, const sp_layout *layout, int k, d
   reference_shapes(mesh->dim, N);
   for (int i = 0; i < mesh->n_nodes; ++i) w[i] = 0.0;
   for (int e = 0; e < mesh->n_elems; ++e) {
-    const int *nodes = mesh->elem + (size_t)nen * e;
+    const int *nodes = sp_mesh_elem_nodes(mesh, e);
     int64_t s = t->elem_start[e]; /* slots by increasing cell */
     while (s < t->elem_start[e + 1] && t->slot_cell[s] < k) ++s;
     if (s == t->elem_start[e + 1] || t->slot_cell[s] != k) continue;
@@ -335,7 +335,8 @@ static double ellipsoid_distance(const double *x, const double *c, const double 
 }
 
 /** The scene's cell k: a disk (2D) or a sphere (3D), or with semi-axes an
- *  ellipse (ellipsoid), with the tanh profile of width d, or sharp. */
+ *  ellipse (ellipsoid), turned by its frame (sp_scene_cell_frame) if it
+ *  gives an axis, with the tanh profile of width d, or sharp. */
 static double disk_profile(int k, const double *x, int dim, void *ctx) {
   const sp_scene *scene = ctx;
   const sp_scene_cell *cell = &scene->cells[k];
@@ -343,7 +344,17 @@ static double disk_profile(int k, const double *x, int dim, void *ctx) {
     const double c[3] = {cell->x, cell->y, cell->z};
     double s[3] = {1, 1, 1}; /* (z unused in 2D) */
     for (int j = 0; j < dim; ++j) s[j] = sp_scene_cell_semi_axis(cell, j);
-    const double distance = ellipsoid_distance(x, c, s, dim);
+    double distance;
+    if (sp_scene_cell_is_turned(cell)) { /* in the cell's frame: R^T (x - c) */
+      double R[3][3], local[3] = {0, 0, 0};
+      const double origin[3] = {0, 0, 0};
+      sp_scene_cell_frame(cell, R);
+      for (int j = 0; j < dim; ++j)
+        for (int d = 0; d < dim; ++d) local[j] += R[d][j] * (x[d] - c[d]);
+      distance = ellipsoid_distance(local, origin, s, dim);
+    } else {
+      distance = ellipsoid_distance(x, c, s, dim);
+    }
     if (cell->profile == SP_PROFILE_SHARP) return distance <= 0 ? 1.0 : 0.0;
     return sp_cells_profile(distance, sp_scene_interface_width(scene));
   }

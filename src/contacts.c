@@ -38,7 +38,7 @@ int sp_contacts_integrate(const sp_mesh *mesh, const sp_layout *layout, const do
   double *grad; /* |grad c| of each slot of an element at one point */
   SP_ALLOC(grad, (size_t)n + 1);
   for (int e = 0; e < mesh->n_elems; ++e) {
-    const int first = mesh->elem[(size_t)nen * e];
+    const int first = sp_mesh_elem_nodes(mesh, e)[0];
     const int64_t s0 = t->elem_start[e], s1 = t->elem_start[e + 1];
     if (first < first_node || first >= end_node || s0 == s1) continue;
     double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];

@@ -2,6 +2,7 @@
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
 static char sp_error_buffer[SP_ERROR_MESSAGE_MAX];
 /* whether the recorded error is agreed by every rank, and whether it is
@@ -9,10 +10,14 @@ static char sp_error_buffer[SP_ERROR_MESSAGE_MAX];
 static int sp_error_is_agreed, sp_error_is_adopted;
 
 int sp_error_set(int code, const char *fmt, ...) {
+  /* through a copy: an argument may be sp_error_message() itself (a
+   * message prefixed with the key it came from) */
+  char text[sizeof sp_error_buffer];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(sp_error_buffer, sizeof sp_error_buffer, fmt, ap);
+  vsnprintf(text, sizeof text, fmt, ap);
   va_end(ap);
+  memcpy(sp_error_buffer, text, sizeof text);
   sp_error_is_agreed = sp_error_is_adopted = 0;
   return code;
 }

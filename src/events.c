@@ -97,14 +97,6 @@ static int update_supports(sp_run *run, sp_step_events *ev) {
   SP_CALL(sp_run_energy(run, &ev->energy));
   ev->have_energy = 1;
   SP_CALL(sp_run_observe(run, run->cells.obs));
-  int outgrown = 0; /* (the same answer on every rank: replicated) */
-  SP_CALL(sp_support_first_outgrown(run->support, run->layout, run->state, &outgrown));
-  if (outgrown && run->rank == 0)
-    fprintf(stderr, "softpack: warning: at t = %.6g the supports were within layout.band of "
-                    "their edge right after they were rebuilt (elements wider than "
-                    "layout.margin - layout.band around a cell): they may change at every "
-                    "step; a larger layout.margin avoids it (docs/local-support.md, \"Coarse "
-                    "meshes\")\n", run->t);
   const double e_before = sp_energy_fields(&before);
   ev->support_changed = 1;
   ev->mass_correction = correction;

@@ -35,7 +35,7 @@ typedef struct {
 static int whole(const sp_mesh *mesh, const sp_layout *to, int e, int k) {
   const int nen = mesh->nodes_per_elem;
   for (int a = 0; a < nen; ++a)
-    if (sp_layout_pair(to, k, mesh->elem[(size_t)nen * e + a]) < 0)
+    if (sp_layout_pair(to, k, sp_mesh_elem_nodes(mesh, e)[a]) < 0)
       return 0;
   return 1;
 }
@@ -73,7 +73,7 @@ static int build_row(const sp_mesh *mesh, const int *ne_start, const int *ne_lis
     if (!whole(mesh, to, e, k))
       continue;
     const int nen = mesh->nodes_per_elem;
-    const int *nodes = mesh->elem + (size_t)nen * e;
+    const int *nodes = sp_mesh_elem_nodes(mesh, e);
     int a = 0;
     while (nodes[a] != i)
       ++a;

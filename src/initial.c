@@ -544,19 +544,19 @@ static int label_grid_state(const sp_scene *scene, const sp_mesh *mesh, const sp
 /* ------------------------------------------------------------------------ */
 
 typedef struct {
-  double x, y;
+  double x[3]; /* (z = 0 on a 2D mesh, as the .vtu has it) */
   int index;
 } sp_point;
 
 static int cmp_point(const void *a, const void *b) {
   const sp_point *p = a, *q = b;
-  if (p->x != q->x) return p->x < q->x ? -1 : 1;
-  if (p->y != q->y) return p->y < q->y ? -1 : 1;
+  for (int d = 0; d < 3; ++d)
+    if (p->x[d] != q->x[d]) return p->x[d] < q->x[d] ? -1 : 1;
   return 0;
 }
 
 /** Every mesh node's point of the .vtu (the same coordinates, bit for bit:
- *  the same mesh, whatever its numbering there). */
+ *  the same mesh, 2D or 3D, whatever its numbering there). */
 static int vtu_state(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *layout,
                      double *state) {
   const char *path = scene->initial.from;
@@ -571,17 +571,19 @@ static int vtu_state(const sp_scene *scene, const sp_mesh *mesh, const sp_layout
   sp_point *a = rc == SP_OK ? malloc(sizeof *a * nn) : NULL, *b = rc == SP_OK ? malloc(sizeof *b * nn) : NULL;
   if (rc == SP_OK && (!a || !b)) rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
   for (int i = 0; rc == SP_OK && i < nn; ++i) {
-    a[i] = (sp_point){mesh->xy[2 * i], mesh->xy[2 * i + 1], i};
-    b[i] = (sp_point){v.xy[2 * i], v.xy[2 * i + 1], i};
+    a[i] = b[i] = (sp_point){.index = i};
+    for (int d = 0; d < mesh->dim; ++d) a[i].x[d] = mesh->xy[(size_t)mesh->dim * i + d];
+    for (int d = 0; d < 3; ++d) b[i].x[d] = v.xyz[3 * (size_t)i + d];
   }
   if (rc == SP_OK) {
     qsort(a, nn, sizeof *a, cmp_point);
     qsort(b, nn, sizeof *b, cmp_point);
   }
   for (int j = 0; rc == SP_OK && j < nn; ++j) {
-    if (a[j].x != b[j].x || a[j].y != b[j].y) {
+    if (cmp_point(&a[j], &b[j]) != 0) {
       rc = sp_error_set(SP_ERR_INPUT, "initial.from: '%s': its points are not this scene's "
-                                      "mesh nodes (node at (%g, %g))", path, a[j].x, a[j].y);
+                                      "mesh nodes (node at (%g, %g, %g))", path, a[j].x[0],
+                        a[j].x[1], a[j].x[2]);
       break;
     }
     for (int k = 0; k < layout->n_cells; ++k) {
@@ -630,8 +632,6 @@ int sp_initial_cell_count(const sp_scene *scene, const sp_mesh *mesh, int *n_cel
 
 int sp_initial_state(const sp_scene *scene, const sp_mesh *mesh, const sp_layout *layout,
                      double *state) {
-  SP_CHECK(mesh->dim == 2 || !(scene->initial.label_image[0] || scene->initial.from[0]),
-           SP_ERR_INPUT, "initial: fields from files are not yet on a 3D mesh (issue 29)");
   if (scene->initial.label_image[0] || scene->initial.label_volume[0])
     return label_grid_state(scene, mesh, layout, state);
   if (scene->initial.from[0]) return vtu_state(scene, mesh, layout, state);

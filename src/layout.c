@@ -197,7 +197,7 @@ static int slots_build(const sp_layout *l, const sp_mesh *m, sp_slots **out) {
   /* At most one slot per pair of an element's first node. */
   int64_t bound = 0;
   for (int e = 0; e < m->n_elems; ++e) {
-    const int n0 = m->elem[(size_t)nen * e];
+    const int n0 = sp_mesh_elem_nodes(m, e)[0];
     bound += l->node_start[n0 + 1] - l->node_start[n0];
   }
   SP_ALLOC(t->elem_start, (size_t)m->n_elems + 1);
@@ -205,7 +205,7 @@ static int slots_build(const sp_layout *l, const sp_mesh *m, sp_slots **out) {
   SP_ALLOC(t->slot_pair, (size_t)nen * (size_t)bound);
   int64_t s = 0;
   for (int e = 0; e < m->n_elems; ++e) {
-    const int *nodes = m->elem + (size_t)nen * e;
+    const int *nodes = sp_mesh_elem_nodes(m, e);
     t->elem_start[e] = s;
     /* Cell k lives on element e only if all its nodes carry it. */
     for (int p0 = l->node_start[nodes[0]]; p0 < l->node_start[nodes[0] + 1]; ++p0) {

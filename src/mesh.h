@@ -151,13 +151,20 @@ int sp_mesh_contains(const sp_mesh *mesh, const double *x);
 /** @brief Free the mesh and set *mesh to NULL. */
 void sp_mesh_destroy(sp_mesh **mesh);
 
+/** @brief Element e's node list: mesh->nodes_per_elem node indices, in
+ *         the reference element's order (q1.h). */
+static inline const int *sp_mesh_elem_nodes(const sp_mesh *m, int e) {
+  return m->elem + (size_t)m->nodes_per_elem * e;
+}
+
 /** @brief Copy element e's node coordinates into xe[a][d], a <
  *         nodes_per_elem, d < dim (the rest of xe is left as it is). */
 static inline void sp_mesh_elem_xy(const sp_mesh *m, int e,
                                    double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM]) {
   const int nen = m->nodes_per_elem, dim = m->dim;
+  const int *nodes = sp_mesh_elem_nodes(m, e);
   for (int a = 0; a < nen; ++a) {
-    const int n = m->elem[(size_t)nen * e + a];
+    const int n = nodes[a];
     for (int d = 0; d < dim; ++d) xe[a][d] = m->xy[(size_t)dim * n + d];
   }
 }

@@ -694,7 +694,7 @@ static void sp_vtu_write(FILE *f, const sp_mesh *mesh, const sp_layout *l, const
   sp_b64_begin_array(&b, f, (uint64_t)ne * nen * sizeof(int32_t));
   for (int j = 0; j < ne; ++j)
     for (int a = 0; a < nen; ++a) {
-      const int node = mesh->elem[(size_t)nen * part_elem(part, j) + a];
+      const int node = sp_mesh_elem_nodes(mesh, part_elem(part, j))[a];
       int32_t n = part->local ? part->local[node] : node;
       sp_b64_put(&b, &n, sizeof n);
     }
@@ -803,7 +803,7 @@ int sp_output_fields_piece(const char *dir, const sp_mesh *mesh, const sp_layout
   for (size_t i = 0; i < nn; ++i) local[i] = -1;
   const int nen = mesh->nodes_per_elem;
   for (size_t e = 0; e < ne; ++e) {
-    const int *en = mesh->elem + (size_t)nen * e;
+    const int *en = sp_mesh_elem_nodes(mesh, e);
     if (en[0] < first_node || en[0] >= end_node) continue; /* the solver's rule */
     elems[n_elems++] = (int)e;
     for (int a = 0; a < nen; ++a) local[en[a]] = 0;
@@ -931,7 +931,7 @@ static void *sp_vtu_array(const char *xml, const char *name, size_t *bytes) {
 }
 
 void sp_vtu_fields_free(sp_vtu_fields *v) {
-  free(v->xy);
+  free(v->xyz);
   free(v->c);
   free(v->mu);
   *v = (sp_vtu_fields){0};
@@ -970,15 +970,12 @@ int sp_vtu_read(const char *path, sp_vtu_fields *out) {
   if (rc == SP_OK) {
     out->n_points = n;
     out->n_cells = n_cells;
-    out->xy = malloc(sizeof(double) * 2 * (size_t)n + 1);
+    out->xyz = malloc(sizeof(double) * 3 * (size_t)n + 1);
     out->c = malloc(sizeof(double) * (size_t)n * n_cells + 1);
     out->mu = malloc(sizeof(double) * (size_t)n * n_cells + 1);
-    if (!out->xy || !out->c || !out->mu) rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
+    if (!out->xyz || !out->c || !out->mu) rc = sp_error_set(SP_ERR_MEMORY, "out of memory");
   }
-  for (int i = 0; rc == SP_OK && i < n; ++i) {
-    out->xy[2 * i] = pts[3 * i];
-    out->xy[2 * i + 1] = pts[3 * i + 1];
-  }
+  if (rc == SP_OK) memcpy(out->xyz, pts, sizeof(double) * 3 * (size_t)n);
   for (int k = 0; rc == SP_OK && k < n_cells; ++k)
     for (int which = 0; rc == SP_OK && which < 2; ++which) {
       char name[32];

@@ -350,9 +350,10 @@ static int sp_omega_outline(cairo_t *cr, const sp_mesh *m, const sp_frame *fr) {
   size_t ne = 0;
   for (int e = 0; e < m->n_elems; ++e) {
     if (m->region && m->region[e] != SP_REGION_OMEGA) continue;
+    const int *node = sp_mesh_elem_nodes(m, e);
     for (int a = 0; a < 4; ++a) {
-      uint32_t u = (uint32_t)m->elem[4 * e + a];
-      uint32_t v = (uint32_t)m->elem[4 * e + (a + 1) % 4];
+      uint32_t u = (uint32_t)node[a];
+      uint32_t v = (uint32_t)node[(a + 1) % 4];
       edges[ne++] = u < v ? (uint64_t)u << 32 | v : (uint64_t)v << 32 | u;
     }
   }
@@ -429,7 +430,7 @@ static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
     for (int tri = 0; tri < 2; ++tri) {
       double P[3][2], v[3];
       for (int a = 0; a < 3; ++a) {
-        int n = m->elem[4 * e + sp_quad_tris[tri][a]];
+        int n = sp_mesh_elem_nodes(m, e)[sp_quad_tris[tri][a]];
         sp_frame_map(fr, m->xy[2 * n], m->xy[2 * n + 1], &P[a][0], &P[a][1]);
         v[a] = phi[n];
       }
@@ -458,7 +459,7 @@ static int sp_draw_cells(cairo_surface_t *surf, const sp_frame *fr,
         double P[3][2], c[3];
         int any = 0;
         for (int a = 0; a < 3; ++a) {
-          int n = m->elem[4 * e + sp_quad_tris[tri][a]];
+          int n = sp_mesh_elem_nodes(m, e)[sp_quad_tris[tri][a]];
           sp_frame_map(fr, m->xy[2 * n], m->xy[2 * n + 1], &P[a][0],
                        &P[a][1]);
           c[a] = sp_c_at(l, state, k, n);
@@ -795,7 +796,7 @@ static int sp_march_tet(const double *p[4], const double v[4], double level, sp_
  * global numbers, so both sides compute it to the same bits.
  */
 static int sp_march_hex(const sp_mesh *m, int e, const double *v, double level, sp_tris *t) {
-  const int *node = m->elem + 8 * (size_t)e;
+  const int *node = sp_mesh_elem_nodes(m, e);
   double val[8];
   int n_in = 0;
   for (int a = 0; a < 8; ++a) {
@@ -1023,9 +1024,10 @@ static void sp_section_fill(uint32_t *data, int stride, const sp_sections_frame 
         if (!sp_hex_locate(xe, X, xi)) continue;
         double N[SP_Q1_MAX_NODES], dN[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM], v = 0;
         sp_q1_shape(3, xi, N, dN);
-        for (int n = 0; n < 8; ++n) v += N[n] * phi[m->elem[8 * (size_t)e + n]];
+        const int *en = sp_mesh_elem_nodes(m, e);
+        for (int n = 0; n < 8; ++n) v += N[n] * phi[en[n]];
         if (sum) { /* names: the pixel's cell, as the .vtu's cell_id */
-          const int k = sp_section_cell(l, state, m->elem + 8 * (size_t)e, N);
+          const int k = sp_section_cell(l, state, en, N);
           if (k >= 0) sum[3 * k] += i + 0.5, sum[3 * k + 1] += j + 0.5, sum[3 * k + 2] += 1;
         }
         double rgb[3];
@@ -1304,7 +1306,7 @@ static int sp_cmp_face_key(const void *a, const void *b) {
 static int sp_omega_face_push(const sp_mesh *m, int e, int f, const sp_camera *cam,
                               sp_faces2d *front, sp_faces2d *back) {
   static const double shell[3] = {0.70, 0.74, 0.80};
-  const int *node = m->elem + 8 * (size_t)e;
+  const int *node = sp_mesh_elem_nodes(m, e);
   double x[4][3], xf[3] = {0, 0, 0}, xc[3] = {0, 0, 0};
   for (int a = 0; a < 8; ++a)
     for (int d = 0; d < 3; ++d) xc[d] += 0.125 * m->xy[3 * (size_t)node[a] + d];
@@ -1342,7 +1344,7 @@ static int sp_omega_faces(const sp_mesh *m, const sp_camera *cam, sp_faces2d *fr
     for (int f = 0; f < 6; ++f) {
       sp_face_key *k = keys + nk++;
       for (int j = 0; j < 4; ++j) {
-        int v = m->elem[8 * (size_t)e + sp_hex_faces[f][j]], i = j;
+        int v = sp_mesh_elem_nodes(m, e)[sp_hex_faces[f][j]], i = j;
         for (; i > 0 && k->key[i - 1] > v; --i) k->key[i] = k->key[i - 1];
         k->key[i] = v;
       }

@@ -97,7 +97,8 @@ int sp_run_file_restart(const char *path, int n_set, const char *const *set,
     if (rc != SP_OK) rc = sp_error_set(rc, "initial.from: %s", sp_error_message());
     as_initial = 1;
   }
-  const sp_run_start start = {.checkpoint = ck, .as_initial = as_initial,
+  const int from_scene = ck && !(restart && (restart->checkpoint || restart->resume_dir));
+  const sp_run_start start = {.checkpoint = ck, .as_initial = as_initial, .from_scene = from_scene,
                               .scene_text = text, .scene_len = len, .n_set = n_set, .set = set};
   rc = run_loaded(rc, scene, &start, out_dir, comm, on_step, user, summary);
   sp_checkpoint_close(&ck);

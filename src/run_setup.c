@@ -116,6 +116,8 @@ static int from_checkpoint(sp_run *run, const sp_scene *scene, const sp_run_star
     run->mon.fields = fields;
     run->mon.n_fields = n_fields;
   }
+  if (rc != SP_OK && start->from_scene) /* (a mesh not the scene's, ...) */
+    return sp_error_set(rc, "initial.from: %s", sp_error_message());
   SP_CALL(rc);
   run->restarted = !start->as_initial;
   if (!start->as_initial) {

@@ -31,6 +31,7 @@ extern "C" {
 typedef struct {
   sp_checkpoint checkpoint;
   int as_initial;
+  int from_scene; /**< the checkpoint is the scene's initial.from (errors name it) */
   const char *scene_text;
   size_t scene_len;
   int n_set;

@@ -275,8 +275,7 @@ static const sp_key sp_keys[] = {
     /* mesh */
     KEY_ENUM(SP_SEC_MESH, "type", mesh.type, SP_MESH_ELLIPSE, sp_mesh_words,
              "-", "domain Omega: a rectangle or the paper's ellipse (2D), or a box "
-             "or an ellipsoid of hexahedra (3D; not yet with initial fields from "
-             "initial.from: issue 29)"),
+             "or an ellipsoid of hexahedra (3D)"),
     KEY_FLOAT(SP_SEC_MESH, "x0", mesh.x0, 0.0, UNBOUNDED, UNBOUNDED, "L",
               "rectangle, box: left edge"),
     KEY_FLOAT(SP_SEC_MESH, "y0", mesh.y0, 0.0, UNBOUNDED, UNBOUNDED, "L",
@@ -653,11 +652,21 @@ static const sp_key sp_keys[] = {
     CELL_FLOAT("semi_x", semi_x, NAN, ABOVE(0.0), UNBOUNDED, "L",
                "semi-axis along x of an elongated cell (none: radius): with semi_y, "
                "semi_z the cell is the ellipse (ellipsoid) with these semi-axes along "
-               "the coordinate axes, radius the ones not given; it must lie inside Omega"),
+               "the coordinate axes (or turned: axis_x), radius the ones not given; it must "
+               "lie inside Omega"),
     CELL_FLOAT("semi_y", semi_y, NAN, ABOVE(0.0), UNBOUNDED, "L",
                "semi-axis along y (none: radius); see semi_x"),
     CELL_FLOAT("semi_z", semi_z, NAN, ABOVE(0.0), UNBOUNDED, "L",
                "semi-axis along z (none: radius); only on a 3D mesh; see semi_x"),
+    CELL_FLOAT("axis_x", axis[0], NAN, UNBOUNDED, UNBOUNDED, "-",
+               "an ellipse's (ellipsoid's) orientation: the direction (axis_x, axis_y, "
+               "axis_z; any length > 0, components not given 0) its semi_x axis is turned "
+               "onto, by the smallest rotation (semi_y, semi_z turn with it; docs/scene.md, "
+               "\"Cells\"); none: along the coordinate axes"),
+    CELL_FLOAT("axis_y", axis[1], NAN, UNBOUNDED, UNBOUNDED, "-",
+               "y component of the semi_x axis' direction; see axis_x"),
+    CELL_FLOAT("axis_z", axis[2], NAN, UNBOUNDED, UNBOUNDED, "-",
+               "z component of the semi_x axis' direction; only on a 3D mesh; see axis_x"),
     CELL_ENUM("profile", profile, SP_PROFILE_TANH, sp_profile_words, "-",
               "initial profile: tanh (equilibrium width d) or sharp (0/1)"),
     NAME_KEY(SP_SEC_CELLS, sp_scene_cell, "name", name, 0,
@@ -1660,12 +1669,9 @@ static int check_time_and_mesh(const sp_scene *scene, const char *file) {
   return check_flatten_key(scene, file);
 }
 
-/** Why a 3D scene cannot have a feature yet (issue 29's later phases). */
-#define SP_NOT_YET_3D "not yet in 3D (mesh.type box, ellipsoid; issue 29)"
-
-/** What a scene on a 3D mesh cannot ask for yet, each refused naming its
- *  key, rather than run wrong: initial fields from files (initial.from);
- *  and on a 2D mesh, the third moment's shape.delta3. */
+/** What a scene of one dimension cannot ask for, each refused naming its
+ *  key: on a 3D mesh a PNG label image, on a 2D mesh the third moment's
+ *  shape.delta3. */
 static int check_3d(const sp_scene *scene, const char *file) {
   if (sp_scene_dim(scene) != 3) {
     SP_CHECK(scene->shape.delta3 == 0, SP_ERR_INPUT,
@@ -1674,9 +1680,6 @@ static int check_3d(const sp_scene *scene, const char *file) {
              file, scene->shape.delta3);
     return SP_OK;
   }
-  SP_CHECK(scene->initial.from[0] == '\0', SP_ERR_INPUT,
-           "%s: initial.from: initial fields from a file are " SP_NOT_YET_3D
-           ": expected none, got '%s'", file, scene->initial.from);
   SP_CHECK(scene->initial.label_image[0] == '\0', SP_ERR_INPUT,
            "%s: initial.label_image: a PNG label image is 2D: expected none on a 3D mesh "
            "(a 3D scene takes a NIfTI label volume, initial.label_volume), got '%s'", file,
@@ -1688,6 +1691,7 @@ static int check_3d(const sp_scene *scene, const char *file) {
  *  given, else its radius. */
 static const char *extent_key(const sp_scene_cell *c, int d) {
   static const char *const semi[3] = {"semi_x", "semi_y", "semi_z"};
+  if (sp_scene_cell_is_turned(c)) return "axis_x"; /* (its extents come from the turn) */
   const double given[3] = {c->semi_x, c->semi_y, c->semi_z};
   return isnan(given[d]) ? "radius" : semi[d];
 }
@@ -1719,9 +1723,11 @@ static int check_sphere_in_ellipsoid(const sp_scene_mesh *m, const sp_scene_cell
     for (int j = 0; j < SP_DISK_CHECK_ANGLES; ++j) {
       const double polar = half_turn * la / SP_SPHERE_CHECK_LATITUDES;
       const double azimuth = 2 * half_turn * j / SP_DISK_CHECK_ANGLES;
-      const double p[3] = {c->x + sp_scene_cell_semi_axis(c, 0) * sin(polar) * cos(azimuth),
-                           c->y + sp_scene_cell_semi_axis(c, 1) * sin(polar) * sin(azimuth),
-                           c->z + sp_scene_cell_semi_axis(c, 2) * cos(polar)};
+      const double local[3] = {sp_scene_cell_semi_axis(c, 0) * sin(polar) * cos(azimuth),
+                               sp_scene_cell_semi_axis(c, 1) * sin(polar) * sin(azimuth),
+                               sp_scene_cell_semi_axis(c, 2) * cos(polar)};
+      double p[3];
+      sp_scene_cell_point(c, 3, centre, local, p);
       SP_CHECK(ellipsoid_level(m, p) <= 1.0, SP_ERR_INPUT,
                "%s: cells[%d].radius: the sphere (or semi-axes) of radius %.15g around (%.15g, "
                "%.15g, %.15g) is not inside the ellipsoid with semi-axes (%.15g, %.15g, %.15g): its point "
@@ -1748,9 +1754,9 @@ static int check_sphere(const sp_scene_mesh *m, const sp_scene_cell *c, int i,
              "mesh.%s1] = [%.15g, %.15g]",
              file, i, name[d], name[d], x[d], name[d], name[d], lo[d], hi[d]);
   for (int d = 0; d < 3 && sp_scene_cell_is_ellipsoid(c); ++d) {
-    const double s = sp_scene_cell_semi_axis(c, d);
+    const double s = sp_scene_cell_extent(c, 3, d);
     SP_CHECK(x[d] - s >= lo[d] && x[d] + s <= hi[d], SP_ERR_INPUT,
-             "%s: cells[%d].%s: the ellipsoid's semi-axis %.15g along %s around (%.15g, "
+             "%s: cells[%d].%s: the ellipsoid's extent %.15g along %s around (%.15g, "
              "%.15g, %.15g) is not inside the box [%.15g, %.15g] x [%.15g, %.15g] x [%.15g, "
              "%.15g]",
              file, i, extent_key(c, d), s, name[d], x[0], x[1], x[2], lo[0], hi[0], lo[1],
@@ -1783,10 +1789,10 @@ static int check_disk_in_rectangle(const sp_scene_mesh *m, const sp_scene_cell *
            file, i, c->y, m->y0, m->y1);
   if (sp_scene_cell_is_ellipsoid(c)) {
     for (int d = 0; d < 2; ++d) {
-      const double x = d == 0 ? c->x : c->y, s = sp_scene_cell_semi_axis(c, d);
+      const double x = d == 0 ? c->x : c->y, s = sp_scene_cell_extent(c, 2, d);
       const double lo = d == 0 ? m->x0 : m->y0, hi = d == 0 ? m->x1 : m->y1;
       SP_CHECK(x - s >= lo && x + s <= hi, SP_ERR_INPUT,
-               "%s: cells[%d].%s: the ellipse's semi-axis %.15g along %s around (%.15g, "
+               "%s: cells[%d].%s: the ellipse's extent %.15g along %s around (%.15g, "
                "%.15g) is not inside the rectangle [%.15g, %.15g] x [%.15g, %.15g]",
                file, i, extent_key(c, d), s, d == 0 ? "x" : "y", c->x, c->y, m->x0, m->x1,
                m->y0, m->y1);
@@ -1817,7 +1823,10 @@ static int check_disk_in_ellipse(const sp_scene_mesh *m, const sp_scene_cell *c,
   const double rx = sp_scene_cell_semi_axis(c, 0), ry = sp_scene_cell_semi_axis(c, 1);
   for (int j = 0; j < SP_DISK_CHECK_ANGLES; ++j) {
     double angle = full_turn * j / SP_DISK_CHECK_ANGLES;
-    double px = c->x + rx * cos(angle), py = c->y + ry * sin(angle);
+    const double centre[2] = {c->x, c->y}, local[2] = {rx * cos(angle), ry * sin(angle)};
+    double p[2];
+    sp_scene_cell_point(c, 2, centre, local, p);
+    const double px = p[0], py = p[1];
     if (!sp_scene_cell_is_ellipsoid(c))
       SP_CHECK(ellipse_level(m, px, py) <= 1.0, SP_ERR_INPUT,
                "%s: cells[%d].radius: the disk of radius %.15g around "
@@ -1839,7 +1848,7 @@ static int check_disk_in_ellipse(const sp_scene_mesh *m, const sp_scene_cell *c,
 static int check_cell_under_coverslip(const sp_scene_mesh *m, int dim, const sp_scene_cell *c,
                                       int i, const char *file) {
   if (!(m->flatten > 0)) return SP_OK;
-  const double centre = dim == 3 ? c->z : c->y, semi = sp_scene_cell_semi_axis(c, dim - 1);
+  const double centre = dim == 3 ? c->z : c->y, semi = sp_scene_cell_extent(c, dim, dim - 1);
   const char *axis = dim == 3 ? "z" : "y";
   SP_CHECK(fabs(centre) + semi <= m->flatten, SP_ERR_INPUT,
            "%s: cells[%d].%s: the cell reaches %s = %.15g, beyond the plane |%s| = "
@@ -1849,12 +1858,32 @@ static int check_cell_under_coverslip(const sp_scene_mesh *m, int dim, const sp_
   return SP_OK;
 }
 
+/** Cell @p i's axis_x, _y, _z: on an ellipse (ellipsoid) only, axis_z on
+ *  a 3D mesh only, not the zero vector. */
+static int check_cell_axis(const sp_scene_cell *c, int i, int dim, const char *file) {
+  if (!sp_scene_cell_is_turned(c)) return SP_OK;
+  SP_CHECK(dim == 3 || isnan(c->axis[2]), SP_ERR_INPUT,
+           "%s: cells[%d].axis_z: only on a 3D mesh (mesh.type box, ellipsoid), got %.15g", file,
+           i, c->axis[2]);
+  SP_CHECK(sp_scene_cell_is_ellipsoid(c), SP_ERR_INPUT,
+           "%s: cells[%d].axis_x: turns an ellipse (ellipsoid): expected semi_x, semi_y or "
+           "semi_z with it, got a %s of radius %.15g", file, i, dim == 3 ? "sphere" : "disk",
+           c->radius);
+  double norm = 0;
+  for (int d = 0; d < 3; ++d) norm = hypot(norm, isnan(c->axis[d]) ? 0.0 : c->axis[d]);
+  SP_CHECK(norm > 0 && isfinite(norm), SP_ERR_INPUT,
+           "%s: cells[%d].axis_x, axis_y%s: expected a direction (a vector of finite "
+           "length > 0), got one of length %g", file, i, dim == 3 ? ", axis_z" : "", norm);
+  return SP_OK;
+}
+
 /** Every cell's centre, and its whole disk (sphere), inside Omega; z
  *  given exactly on a 3D mesh. */
 static int check_cells(const sp_scene *scene, const char *file) {
   const sp_scene_mesh *m = &scene->mesh;
   for (int i = 0; i < scene->n_cells; ++i) {
     const sp_scene_cell *c = &scene->cells[i];
+    SP_CALL(check_cell_axis(c, i, sp_scene_dim(scene), file));
     if (sp_scene_dim(scene) == 3) {
       SP_CALL(check_sphere(m, c, i, file));
       SP_CALL(check_cell_under_coverslip(m, 3, c, i, file));
@@ -2078,6 +2107,57 @@ static int fill_scene(sp_scene *scene, const char *path, const char *text,
   SP_CALL(check_lineage(scene, where));
   SP_CALL(check_sizes(scene, scene->n_cells, "cells", where));
   return SP_OK;
+}
+
+int sp_scene_cell_is_turned(const sp_scene_cell *cell) {
+  return !isnan(cell->axis[0]) || !isnan(cell->axis[1]) || !isnan(cell->axis[2]);
+}
+
+void sp_scene_cell_frame(const sp_scene_cell *cell, double R[3][3]) {
+  for (int d = 0; d < 3; ++d)
+    for (int j = 0; j < 3; ++j) R[d][j] = d == j;
+  if (!sp_scene_cell_is_turned(cell)) return;
+  double a[3], norm = 0;
+  for (int d = 0; d < 3; ++d) {
+    a[d] = isnan(cell->axis[d]) ? 0.0 : cell->axis[d];
+    norm = hypot(norm, a[d]);
+  }
+  for (int d = 0; d < 3; ++d) a[d] /= norm; /* (not 0: check_cell_axis) */
+  if (a[0] <= -1.0) { /* -x: a half turn about z */
+    R[0][0] = R[1][1] = -1;
+    return;
+  }
+  /* Rodrigues: R = I + [v]x + [v]x^2 / (1 + c), v = x cross a, c = x . a */
+  const double v[3] = {0, -a[2], a[1]}, f = 1 / (1 + a[0]);
+  const double K[3][3] = {{0, -v[2], v[1]}, {v[2], 0, -v[0]}, {-v[1], v[0], 0}};
+  for (int d = 0; d < 3; ++d)
+    for (int j = 0; j < 3; ++j) {
+      double kk = 0;
+      for (int m = 0; m < 3; ++m) kk += K[d][m] * K[m][j];
+      R[d][j] += K[d][j] + f * kk;
+    }
+}
+
+double sp_scene_cell_extent(const sp_scene_cell *cell, int dim, int d) {
+  if (!sp_scene_cell_is_turned(cell)) return sp_scene_cell_semi_axis(cell, d);
+  double R[3][3], e = 0;
+  sp_scene_cell_frame(cell, R);
+  for (int j = 0; j < dim; ++j) e = hypot(e, R[d][j] * sp_scene_cell_semi_axis(cell, j));
+  return e;
+}
+
+void sp_scene_cell_point(const sp_scene_cell *cell, int dim, const double *centre,
+                         const double *local, double *out) {
+  if (!sp_scene_cell_is_turned(cell)) {
+    for (int d = 0; d < dim; ++d) out[d] = centre[d] + local[d];
+    return;
+  }
+  double R[3][3];
+  sp_scene_cell_frame(cell, R);
+  for (int d = 0; d < dim; ++d) {
+    out[d] = centre[d];
+    for (int j = 0; j < dim; ++j) out[d] += R[d][j] * local[j];
+  }
 }
 
 double sp_scene_cell_semi_axis(const sp_scene_cell *cell, int d) {

@@ -103,6 +103,9 @@ typedef struct {
   double semi_x, semi_y, semi_z; /**< semi-axes of an ellipse (ellipsoid)
                         cell along x, y, z; NaN (not given): the radius
                         (sp_scene_cell_semi_axis); semi_z only in 3D */
+  double axis[3];  /**< the direction the semi_x axis is turned onto
+                        (axis_x, _y, _z; NaN: not given; all NaN: along
+                        x; sp_scene_cell_frame) */
   sp_profile_kind profile; /**< tanh (equilibrium width) or sharp */
   char name[SP_CELL_NAME_MAX]; /**< its name ("": none; lineage.h) */
 } sp_scene_cell;
@@ -134,6 +137,29 @@ double sp_scene_cell_semi_axis(const sp_scene_cell *cell, int d);
 /** @brief 1 if @p cell gives any semi-axis (an ellipse or ellipsoid), 0 for
  *         a disk or sphere of its radius. */
 int sp_scene_cell_is_ellipsoid(const sp_scene_cell *cell);
+
+/** @brief 1 if @p cell is turned (axis_x, axis_y or axis_z given). */
+int sp_scene_cell_is_turned(const sp_scene_cell *cell);
+
+/**
+ * @brief The cell's frame: R[d][j] is coordinate d of its j-th semi-axis
+ *        direction (semi_x, semi_y, semi_z). Not turned: the identity;
+ *        turned: the smallest rotation taking x onto its axis (normalised;
+ *        components not given are 0), about x cross axis (a half turn
+ *        about z when the axis is -x). In 2D (no axis_z) a turn in the
+ *        plane by the axis' angle.
+ */
+void sp_scene_cell_frame(const sp_scene_cell *cell, double R[3][3]);
+
+/** @brief The cell's half-extent along coordinate @p d: its semi-axis
+ *         along d when not turned, else sqrt(sum_j (R[d][j] s_j)^2) (the
+ *         frame R, semi-axes s; @p dim of them). */
+double sp_scene_cell_extent(const sp_scene_cell *cell, int dim, int d);
+
+/** @brief The point @p centre + R @p local of cell @p cell's frame (dim
+ *         coordinates; exactly centre + local when not turned). */
+void sp_scene_cell_point(const sp_scene_cell *cell, int dim, const double *centre,
+                         const double *local, double *out);
 
 /** noise: the initial background of every field. */
 typedef struct {

@@ -20,7 +20,6 @@ struct sp_support_s {
   /* scratch marks, n_nodes each, all 0 between calls: a candidate support
    * and the nodes of its whole elements (closing a support) */
   unsigned char *member, *kept;
-  int outgrown_reported; /* sp_support_first_outgrown said so once */
 };
 
 /** Per-cell node lists being built (CSR: cell k's nodes are
@@ -36,13 +35,13 @@ static int node_elements(struct sp_support_s *s) {
   const sp_mesh *mesh = s->mesh;
   const int nn = mesh->n_nodes, ne = mesh->n_elems, nen = mesh->nodes_per_elem;
   for (int e = 0; e < ne; ++e)
-    for (int a = 0; a < nen; ++a) ++s->ne_start[mesh->elem[(size_t)nen * e + a] + 1];
+    for (int a = 0; a < nen; ++a) ++s->ne_start[sp_mesh_elem_nodes(mesh, e)[a] + 1];
   for (int i = 0; i < nn; ++i) s->ne_start[i + 1] += s->ne_start[i];
   int *fill;
   SP_ALLOC(fill, nn);
   for (int e = 0; e < ne; ++e) {
     for (int a = 0; a < nen; ++a) {
-      int n = mesh->elem[(size_t)nen * e + a];
+      int n = sp_mesh_elem_nodes(mesh, e)[a];
       s->ne_list[s->ne_start[n] + fill[n]++] = e;
     }
   }
@@ -96,11 +95,6 @@ static double node_distance(const sp_mesh *m, int i, int j) {
   return r;
 }
 
-/** Element e's nodes (mesh->nodes_per_elem of them). */
-static const int *element_nodes(const sp_mesh *m, int e) {
-  return m->elem + (size_t)m->nodes_per_elem * e;
-}
-
 /**
  * Multi-source search from the n_seeds nodes in s->queue[0..n_seeds):
  * every node reachable through element neighbours whose straight distance
@@ -121,7 +115,7 @@ static int grow_from_seeds(sp_support s, int n_seeds, double radius,
   while (head < tail) {
     const int i = s->queue[head++];
     for (int t = s->ne_start[i]; t < s->ne_start[i + 1]; ++t) {
-      const int *nodes = element_nodes(m, s->ne_list[t]);
+      const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
       for (int a = 0; a < m->nodes_per_elem; ++a) {
         const int j = nodes[a];
         if (allowed && !allowed[j]) continue;
@@ -187,7 +181,7 @@ static int lists_push(cell_lists *L, int n_cells_done, int i) {
 
 /** Every node of element e is marked in s->member. */
 static int all_members(sp_support s, int e) {
-  const int *nodes = element_nodes(s->mesh, e);
+  const int *nodes = sp_mesh_elem_nodes(s->mesh, e);
   for (int a = 0; a < s->mesh->nodes_per_elem; ++a)
     if (!s->member[nodes[a]]) return 0;
   return 1;
@@ -206,7 +200,7 @@ static int close_to_elements(sp_support s, int n, int k, cell_lists *L) {
   for (int q = 0; q < n && rc == SP_OK; ++q)
     for (int t = s->ne_start[s->queue[q]]; t < s->ne_start[s->queue[q] + 1]; ++t) {
       if (!all_members(s, s->ne_list[t])) continue;
-      const int *nodes = element_nodes(m, s->ne_list[t]);
+      const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
       for (int a = 0; a < m->nodes_per_elem && rc == SP_OK; ++a)
         if (!s->kept[nodes[a]]) {
           s->kept[nodes[a]] = 1;
@@ -214,6 +208,32 @@ static int close_to_elements(sp_support s, int n, int k, cell_lists *L) {
         }
     }
   for (int q = 0; q < n; ++q) s->member[s->queue[q]] = s->kept[s->queue[q]] = 0;
+  return rc;
+}
+
+/**
+ * Widen cell k's support, L's last list (closed to whole elements), by
+ * @p layers layers of elements: each layer adds every element touching it
+ * (so the list stays closed). Costs the elements around the support.
+ */
+static int widen_by_layers(sp_support s, int k, int layers, cell_lists *L) {
+  const sp_mesh *m = s->mesh;
+  const int64_t j0 = L->start[k];
+  int rc = SP_OK;
+  for (int64_t j = j0; j < L->start[k + 1]; ++j) s->member[L->node[j]] = 1;
+  for (int layer = 0; layer < layers && rc == SP_OK; ++layer) {
+    const int64_t j1 = L->start[k + 1]; /* the support the layer goes around */
+    for (int64_t j = j0; j < j1 && rc == SP_OK; ++j)
+      for (int t = s->ne_start[L->node[j]]; t < s->ne_start[L->node[j] + 1] && rc == SP_OK; ++t) {
+        const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
+        for (int a = 0; a < m->nodes_per_elem && rc == SP_OK; ++a)
+          if (!s->member[nodes[a]]) {
+            s->member[nodes[a]] = 1;
+            rc = lists_push(L, k, nodes[a]);
+          }
+      }
+  }
+  for (int64_t j = j0; j < L->start[k + 1]; ++j) s->member[L->node[j]] = 0;
   return rc;
 }
 
@@ -257,8 +277,10 @@ int sp_support_layout_from_masks(sp_support s, int n_cells, unsigned char *mask,
   return rc;
 }
 
-int sp_support_layout(sp_support s, const sp_layout *layout, const double *state,
-                      const unsigned char *may_shrink, sp_layout **out) {
+/** sp_support_layout with cell k's support widened by layers[k] layers of
+ *  elements (@p layers NULL: none). */
+static int widened_layout(sp_support s, const sp_layout *layout, const double *state,
+                          const unsigned char *may_shrink, const int *layers, sp_layout **out) {
   const int nc = layout->n_cells;
   const sp_cell_pairs *cp;
   SP_CALL(sp_layout_cells(layout, &cp));
@@ -274,21 +296,50 @@ int sp_support_layout(sp_support s, const sp_layout *layout, const double *state
           s->queue[n++] = cp->cell_node[j];
         }
     rc = close_to_elements(s, n, k, &L);
+    if (rc == SP_OK && layers && layers[k] > 0) rc = widen_by_layers(s, k, layers[k], &L);
   }
   if (rc == SP_OK) rc = sp_layout_create_from_lists(layout->n_nodes, nc, L.start, L.node, out);
   lists_free(&L);
   return rc;
 }
 
+int sp_support_layout(sp_support s, const sp_layout *layout, const double *state,
+                      const unsigned char *may_shrink, sp_layout **out) {
+  return widened_layout(s, layout, state, may_shrink, NULL, out);
+}
+
 /** Node i of cell k's support is on its edge: an element around it is not
  *  whole for cell k. */
 static int on_edge(sp_support s, const sp_layout *layout, int k, int i) {
   for (int t = s->ne_start[i]; t < s->ne_start[i + 1]; ++t) {
-    const int *nodes = element_nodes(s->mesh, s->ne_list[t]);
+    const int *nodes = sp_mesh_elem_nodes(s->mesh, s->ne_list[t]);
     for (int a = 0; a < s->mesh->nodes_per_elem; ++a)
       if (sp_layout_pair(layout, k, nodes[a]) < 0) return 1;
   }
   return 0;
+}
+
+/** Whether cell k's c_k >= grow_threshold within the band of its
+ *  support's edge (sp_support_needs_update for one cell). */
+static int cell_needs_update(sp_support s, const sp_layout *layout, const sp_cell_pairs *cp,
+                             const double *state, int k) {
+  /* the search stays in cell k's support, from its edge (by increasing
+   * node): cell k's pairs, not the mesh's nodes */
+  const int64_t j0 = cp->cell_start[k], j1 = cp->cell_start[k + 1];
+  int n_seeds = 0, grow = 0;
+  for (int64_t j = j0; j < j1; ++j) {
+    const int i = cp->cell_node[j];
+    s->member[i] = 1;
+    if (on_edge(s, layout, k, i)) s->queue[n_seeds++] = i;
+  }
+  int reached = grow_from_seeds(s, n_seeds, s->params.band, s->member);
+  for (int q = 0; q < reached && !grow; ++q) {
+    int p = sp_layout_pair(layout, k, s->queue[q]);
+    grow = state[2 * p] >= s->params.grow_threshold;
+  }
+  clear_set(s, reached);
+  for (int64_t j = j0; j < j1; ++j) s->member[cp->cell_node[j]] = 0;
+  return grow;
 }
 
 int sp_support_needs_update(sp_support s, const sp_layout *layout, const double *state,
@@ -298,35 +349,8 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout, const double 
   /* (a failure is an error, not "rebuild": every rank must decide alike) */
   SP_CALL(sp_layout_cells(layout, &cp));
   int grow = 0;
-  for (int k = 0; k < layout->n_cells && !grow; ++k) {
-    /* the search stays in cell k's support, from its edge (by increasing
-     * node): cell k's pairs, not the mesh's nodes */
-    const int64_t j0 = cp->cell_start[k], j1 = cp->cell_start[k + 1];
-    int n_seeds = 0;
-    for (int64_t j = j0; j < j1; ++j) {
-      const int i = cp->cell_node[j];
-      s->member[i] = 1;
-      if (on_edge(s, layout, k, i)) s->queue[n_seeds++] = i;
-    }
-    int reached = grow_from_seeds(s, n_seeds, s->params.band, s->member);
-    for (int q = 0; q < reached && !grow; ++q) {
-      int p = sp_layout_pair(layout, k, s->queue[q]);
-      grow = state[2 * p] >= s->params.grow_threshold;
-    }
-    clear_set(s, reached);
-    for (int64_t j = j0; j < j1; ++j) s->member[cp->cell_node[j]] = 0;
-  }
+  for (int k = 0; k < layout->n_cells && !grow; ++k) grow = cell_needs_update(s, layout, cp, state, k);
   *needed = grow;
-  return SP_OK;
-}
-
-int sp_support_first_outgrown(sp_support s, const sp_layout *layout, const double *state,
-                              int *first) {
-  *first = 0;
-  if (s->outgrown_reported) return SP_OK;
-  int outgrown = 0;
-  SP_CALL(sp_support_needs_update(s, layout, state, &outgrown));
-  *first = s->outgrown_reported = outgrown;
   return SP_OK;
 }
 
@@ -462,15 +486,18 @@ int sp_support_fill(sp_support s, const sp_layout *layout, const double *state,
 /** The interior of a cell, where support changes restore its mass. */
 #define SP_SUPPORT_INTERIOR 0.5
 
-int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *state,
-                       const unsigned char *may_shrink, sp_layout **new_layout,
-                       double **new_state, double *mass_correction, double *mass_dropped) {
+/** sp_support_rebuild with cell k's support widened by layers[k] layers of
+ *  elements. */
+static int rebuild_widened(sp_support s, const sp_layout *layout, const double *state,
+                           const unsigned char *may_shrink, const int *layers,
+                           sp_layout **new_layout, double **new_state, double *mass_correction,
+                           double *mass_dropped) {
   const int nc = layout->n_cells;
   *new_layout = NULL;
   *new_state = NULL;
   *mass_correction = 0;
   *mass_dropped = 0;
-  SP_CALL(sp_support_layout(s, layout, state, may_shrink, new_layout));
+  SP_CALL(widened_layout(s, layout, state, may_shrink, layers, new_layout));
   sp_layout *to = *new_layout;
   double *next;
   SP_ALLOC(next, 2 * (size_t)to->n_pairs);
@@ -522,5 +549,40 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   free(w);
   free(before);
   free(after);
+  return rc;
+}
+
+int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *state,
+                       const unsigned char *may_shrink, sp_layout **new_layout,
+                       double **new_state, double *mass_correction, double *mass_dropped) {
+  const int nc = layout->n_cells;
+  int *layers;
+  SP_ALLOC(layers, nc ? nc : 1);
+  int rc = SP_OK, outgrown = 1;
+  *new_layout = NULL;
+  *new_state = NULL;
+  /* A support closed to whole elements can lose up to an element's width
+   * of its margin, and new nodes start from the far field: a support just
+   * rebuilt can already call for an update (elements wider than margin -
+   * band around the cell, or a far field above grow_threshold), and the
+   * supports would change at every step. Each such cell's support is
+   * widened by one more layer of elements until none is (a support that
+   * covers the mesh has no edge, so this ends). Supports that do not call
+   * for one are as computed (docs/local-support.md, "Coarse meshes"). */
+  while (rc == SP_OK && outgrown) {
+    sp_layout_destroy(new_layout);
+    free(*new_state);
+    rc = rebuild_widened(s, layout, state, may_shrink, layers, new_layout, new_state,
+                         mass_correction, mass_dropped);
+    const sp_cell_pairs *cp;
+    if (rc == SP_OK) rc = sp_layout_cells(*new_layout, &cp);
+    outgrown = 0;
+    for (int k = 0; k < nc && rc == SP_OK; ++k)
+      if (cell_needs_update(s, *new_layout, cp, *new_state, k)) {
+        ++layers[k];
+        outgrown = 1;
+      }
+  }
+  free(layers);
   return rc;
 }

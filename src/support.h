@@ -70,18 +70,6 @@ int sp_support_needs_update(sp_support s, const sp_layout *layout,
                             const double *state, int *needed);
 
 /**
- * @brief Whether supports just rebuilt from @p state already need an
- *        update (sp_support_needs_update on the new layout and state),
- *        told once per sp_support: a support closed to whole elements can
- *        lose up to an element's width of its margin, so where elements
- *        are wider than margin - band the rule asks for a change at every
- *        step (docs/local-support.md, "Coarse meshes").
- * @param[out] first 1 the first time this holds, else 0
- */
-int sp_support_first_outgrown(sp_support s, const sp_layout *layout, const double *state,
-                              int *first);
-
-/**
  * @brief The values of @p state (on @p layout) on the layout @p to, each
  *        cell's mass not yet restored: kept pairs by (cell, node), new
  *        pairs the far field continued from the old edge
@@ -95,7 +83,13 @@ int sp_support_fill(sp_support s, const sp_layout *layout, const double *state,
  *        restored. @p new_layout and @p new_state are allocated here.
  *
  * A cell k with may_shrink[k] = 0 keeps every node of its old support (the
- * new one is the union of the old and the computed one). Shrinking drops
+ * new one is the union of the old and the computed one). A support that
+ * would already call for an update (sp_support_needs_update on the new
+ * layout and state: a support closed to whole elements loses up to an
+ * element's width of its margin, new nodes start from the far field) is
+ * widened by layers of elements until it does not, so the supports just
+ * rebuilt never call for another change before the cells move
+ * (docs/local-support.md, "Coarse meshes"). Shrinking drops
  * the far field c_k keeps outside its cell (its Gibbs-Thomson level, not 0)
  * and puts that mass back into the cell, which costs mu x (mass) against
  * the f(c) x (area) removed: the energy rises (docs/local-support.md).

@@ -19,9 +19,17 @@
  *  - a scene's ellipsoidal cell (cells[0].semi_x, semi_z): the initial
  *    membrane encloses 4/3 pi a b c (within 3%), its long and short axes
  *    are x and z (1e-3 rad); in 2D an ellipse (semi_x) encloses pi a b
- *    (3%) with its long axis x. */
+ *    (3%) with its long axis x;
+ *  - the same cell turned (cells[0].axis_x, axis_y, axis_z = (1, 2, 2)):
+ *    the same volume (3%), its long axis (v3, cells.csv's long_x, _y,
+ *    _z) the given direction and its short one the turned z (1e-3 rad,
+ *    the unturned cell's tolerance), and the turn takes x onto it by the
+ *    smallest rotation; turned onto y (axis (0, 1, 0)) the field is the
+ *    one of semi_y = 0.16 to round-off (1e-15); a zero axis and axis_z
+ *    in 2D are refused naming the key. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "cells.h"
 #include "check.h"
@@ -284,6 +292,111 @@ static void test_initial_ellipsoid(void) {
   sp_scene_destroy(&scene);
 }
 
+/** The initial state of @p text's one cell on its box: observables, and
+ *  the field in *state (the caller frees it). */
+static sp_cell_obs initial_cell(const char *text, double **state, int *n) {
+  sp_scene *scene;
+  sp_cell_obs o = {0};
+  CHECK_OK(sp_scene_load_text("turned.yaml", text, strlen(text), 0, NULL, &scene));
+  if (sp_test_failures) return o;
+  const sp_scene_mesh *m = &scene->mesh;
+  sp_mesh *mesh;
+  sp_layout *layout;
+  CHECK_OK(sp_mesh_box(m->x0, m->y0, m->z0, m->x1, m->y1, m->z1, m->nx, m->ny, m->nz, &mesh));
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
+  *n = layout->n_pairs;
+  *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
+  CHECK_OK(sp_cells_initial_state(scene, mesh, layout, *state));
+  CHECK_OK(sp_cells_observe(mesh, layout, *state, WEIGHT_THRESHOLD, &o));
+  sp_layout_destroy(&layout);
+  sp_mesh_destroy(&mesh);
+  sp_scene_destroy(&scene);
+  return o;
+}
+
+/* A turned ellipsoid (cells[0].axis_x, axis_y, axis_z): its long axis is
+ * the given direction, the frame the smallest rotation onto it. */
+static void test_turned_ellipsoid(void) {
+  static const char box[] =
+      "mesh: {type: box, x0: 0, y0: 0, z0: 0, x1: 0.5, y1: 0.5, z1: 0.5, nx: 40, ny: 40, "
+      "nz: 40}\n"
+      "noise: {background: 0, amplitude: 0}\n"
+      "output: {pictures: false}\n"
+      "cells:\n";
+  char text[1024];
+  double *state = NULL, *along_y = NULL;
+  int n = 0, m = 0;
+  snprintf(text, sizeof text, "%s  - {x: 0.2517, y: 0.2483, z: 0.2509, radius: 0.1, semi_x: "
+           "0.16, semi_z: 0.07, axis_x: 1, axis_y: 2, axis_z: 2}\n", box);
+  const sp_cell_obs o = initial_cell(text, &state, &n);
+  if (sp_test_failures) return;
+  /* x onto u = (1, 2, 2) / 3 by the smallest rotation, about v = x cross
+   * u = (0, -2, 2) / 3 (Rodrigues, c = x . u = 1/3): z goes to
+   * (-2, -1, 2) / 3, normal to u */
+  const double u[3] = {1.0 / 3, 2.0 / 3, 2.0 / 3}, c = u[0], f = 1 / (1 + c);
+  const double v[3] = {0, -u[2], u[1]};
+  /* R e3 = e3 + v x e3 + f v x (v x e3) */
+  const double vxz[3] = {v[1], -v[0], 0};
+  const double vxvxz[3] = {v[1] * vxz[2] - v[2] * vxz[1], v[2] * vxz[0] - v[0] * vxz[2],
+                           v[0] * vxz[1] - v[1] * vxz[0]};
+  const double z_turned[3] = {vxz[0] + f * vxvxz[0], vxz[1] + f * vxvxz[1],
+                              1 + vxz[2] + f * vxvxz[2]};
+  const double volume = 4.0 / 3.0 * acos(-1.0) * 0.16 * 0.1 * 0.07;
+  printf("turned ellipsoid 0.16 x 0.1 x 0.07, axis (1, 2, 2): volume %.6g (%.6g), long axis "
+         "(%.6f, %.6f, %.6f) off by %.2e rad, short off the turned z (%.4f, %.4f, %.4f) by "
+         "%.2e\n", o.area, volume, o.v3[0], o.v3[1], o.v3[2], line_angle3(o.v3, u),
+         z_turned[0], z_turned[1], z_turned[2], line_angle3(o.v1, z_turned));
+  CHECK(fabs(dot3(z_turned, z_turned) - 1) < 1e-15 && fabs(dot3(z_turned, u)) < 1e-15,
+        "the turned z is not a unit vector normal to u");
+  CHECK(fabs(o.area - volume) <= 0.03 * volume, "volume %g, ellipsoid %g", o.area, volume);
+  CHECK(line_angle3(o.v3, u) < 1e-3, "long axis (%g, %g, %g), given (1, 2, 2) / 3", o.v3[0],
+        o.v3[1], o.v3[2]);
+  CHECK(line_angle3(o.v1, z_turned) < 1e-3, "short axis (%g, %g, %g), turned z (%g, %g, %g)",
+        o.v1[0], o.v1[1], o.v1[2], z_turned[0], z_turned[1], z_turned[2]);
+  free(state);
+
+  /* turned onto y: the cell of semi_y = 0.16 (a quarter turn about z,
+   * whose frame is exact) */
+  snprintf(text, sizeof text, "%s  - {x: 0.2517, y: 0.2483, z: 0.2509, radius: 0.1, semi_x: "
+           "0.16, semi_z: 0.07, axis_y: 1}\n", box);
+  initial_cell(text, &state, &n);
+  snprintf(text, sizeof text, "%s  - {x: 0.2517, y: 0.2483, z: 0.2509, radius: 0.1, semi_y: "
+           "0.16, semi_z: 0.07}\n", box);
+  initial_cell(text, &along_y, &m);
+  double worst = 0;
+  for (int p = 0; p < n && n == m && state && along_y; ++p)
+    worst = fmax(worst, fabs(state[2 * p] - along_y[2 * p]));
+  printf("turned onto y against semi_y: largest difference of c %.2e\n", worst);
+  CHECK(n == m && worst <= 1e-15, "turned onto y: c differs by %.3g from semi_y's", worst);
+  free(state);
+  free(along_y);
+
+  /* bad input: a zero axis, axis_z in 2D, an axis on a sphere, a turned
+   * cell leaving the box */
+  static const char *const bad[][2] = {
+      {"mesh: {type: box, x1: 0.5, y1: 0.5, z1: 0.5, nx: 4, ny: 4, nz: 4}\ncells:\n  - {x: "
+       "0.25, y: 0.25, z: 0.25, radius: 0.1, semi_x: 0.15, axis_x: 0, axis_y: 0, axis_z: 0}\n",
+       "cells[0].axis_x"},
+      {"mesh: {type: rectangle, x1: 0.5, y1: 0.5, nx: 4, ny: 4}\ncells:\n  - {x: 0.25, y: "
+       "0.25, radius: 0.1, semi_x: 0.15, axis_z: 1}\n", "cells[0].axis_z"},
+      {"mesh: {type: box, x1: 0.5, y1: 0.5, z1: 0.5, nx: 4, ny: 4, nz: 4}\ncells:\n  - {x: "
+       "0.25, y: 0.25, z: 0.25, radius: 0.1, axis_x: 1}\n", "cells[0].axis_x"},
+      /* fits along x (extent 0.2 in x, 0.05 in z), not turned onto (1, 0, 1):
+       * its extent in z is then 0.146 > 0.1 */
+      {"mesh: {type: box, x1: 0.5, y1: 0.5, z1: 0.2, nx: 4, ny: 4, nz: 4}\ncells:\n  - {x: "
+       "0.25, y: 0.25, z: 0.1, radius: 0.05, semi_x: 0.2, axis_x: 1, axis_z: 1}\n",
+       "cells[0].axis_x"}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+    sp_scene *scene = NULL;
+    sp_error_clear();
+    const int rc = sp_scene_load_text("bad.yaml", bad[i][0], strlen(bad[i][0]), 0, NULL, &scene);
+    printf("refused: %s\n", sp_error_message());
+    CHECK(rc == SP_ERR_INPUT && !scene && strstr(sp_error_message(), bad[i][1]),
+          "rc %d, %s: %s", rc, bad[i][1], sp_error_message());
+    sp_scene_destroy(&scene);
+  }
+}
+
 /* The same keys in 2D: an elliptical cell (semi_x) on a rectangle. */
 static void test_initial_ellipse_2d(void) {
   static const char text[] =
@@ -322,5 +435,6 @@ int main(void) {
   test_rotation();
   test_initial_ellipsoid();
   test_initial_ellipse_2d();
+  test_turned_ellipsoid();
   TEST_DONE();
 }

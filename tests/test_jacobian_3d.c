@@ -9,7 +9,11 @@
  *    1e-6, DFad = AD to 1e-12;
  *  - a backward-Euler step of two touching spheres solved with the AD and
  *    with the hand Jacobian takes the same Newton iterations to the same
- *    state (1e-10). */
+ *    state (1e-10);
+ *  - `softpack check-jacobian` on a 3D scene with the shape term on the
+ *    three moments (tests/scenes/shape_3d.yaml, implicit): exit 0, hand
+ *    = AD to 1e-12 (its largest relative difference). */
+#include "command.h"
 #include "fixtures.h"
 
 /* A 4 x 3 x 3 box with every node moved by up to 0.15 of an element, and
@@ -106,12 +110,26 @@ static void newton_step(void) {
   sp_mesh_destroy(&mesh);
 }
 
+/* The program's check-jacobian on a 3D scene with the shape term. */
+static void cli_check_jacobian(void) {
+  static char out[16384];
+  const int status =
+      run_softpack("check-jacobian " SP_SOURCE_DIR "/tests/scenes/shape_3d.yaml", out, sizeof out);
+  const char *line = strstr(out, "hand vs ad: largest relative difference ");
+  double hand_ad = INFINITY;
+  if (line) sscanf(line + strlen("hand vs ad: largest relative difference "), "%lf", &hand_ad);
+  printf("check-jacobian shape_3d.yaml: exit %d, hand vs ad %.3g\n", status, hand_ad);
+  CHECK(status == 0, "exit %d: %s", status, out);
+  CHECK(hand_ad <= 1e-12, "hand vs AD %.3g: %s", hand_ad, out);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   sp_mesh *mesh = distorted_box();
   for (int n_cells = 1; n_cells <= 3; ++n_cells) random_state(mesh, n_cells, 23 + n_cells);
   sp_mesh_destroy(&mesh);
   newton_step();
+  cli_check_jacobian();
   MPI_Finalize();
   TEST_DONE();
 }

@@ -6,15 +6,16 @@
  *    centred outside it, a cell without z: refused naming the key;
  *  - bad 3D input is refused as bad input (SP_ERR_INPUT) with a message
  *    naming the key: z1 <= z0, a cell without z, a sphere poking out of
- *    the box, a z on a 2D mesh, and each feature not yet in 3D (initial
- *    fields from files) with "not yet"; pictures and checkpoints load;
+ *    the box, a z on a 2D mesh, a PNG label image (initial.from is 3D
+ *    too: test_initial_3d); pictures and checkpoints load;
  *    the shape term loads with its three moduli (shape.delta3 too), and
  *    a 2D scene's shape.delta3 is refused;
  *  - divisions load in 3D (phase 2) with any layout.support, and so do
  *    local supports (explicit, or auto with 5 cells or with divisions that
  *    can make more than 4), as in 2D;
- *  - `softpack run` of such a scene (and of a 2D one with shape.delta3)
- *    exits 2, names the key and writes nothing. */
+ *  - `softpack run` of such a scene (initial.from a missing file, a 2D
+ *    one with shape.delta3, ...) exits 2, names the key and writes
+ *    nothing. */
 #include <string.h>
 #include <sys/stat.h>
 
@@ -132,7 +133,6 @@ int main(void) {
   CHECK(scene->output.checkpoint_every == 5, "checkpoint_every %d",
         scene->output.checkpoint_every);
   sp_scene_destroy(&scene);
-  refused(NULL, "initial: {from: run.h5}\n", "initial.from", "not yet in 3D");
   refused(NULL, "initial: {label_image: cells.png}\n", "initial.label_image",
           "initial.label_volume");
 
@@ -162,10 +162,10 @@ int main(void) {
   /* the program: exit 2, the key named, nothing written */
   FILE *f = fopen("test_scene_3d.yaml", "w");
   CHECK(f != NULL, "cannot write the scene");
-  fprintf(f, "%s%s%sinitial: {from: run.h5}\n", good_mesh, good_output, good_cells);
+  fprintf(f, "%s%sinitial: {from: run.h5}\n", good_mesh, good_output); /* (a missing file) */
   fclose(f);
   run_refused("run test_scene_3d.yaml --quiet --out test_scene_3d_out", "initial.from",
-              "not yet in 3D");
+              "run.h5");
   /* a 2D scene's shape.delta3 by --set */
   run_refused("run " SP_SOURCE_DIR "/tests/scenes/rectangle_full.yaml --quiet --out "
               "test_scene_3d_out --set shape.delta3=1e5",
