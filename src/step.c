@@ -17,9 +17,18 @@
 #include "time_scheme.h"
 #include "wall_clock.h"
 
-/** solver.predictor linear: the last increment is scaled by dt / dt_last,
- *  at most this much (algorithm 2's ramp multiplies dt by up to 64). */
+/** Extrapolations from the last step (solver.predictor linear, the
+ *  source's indicator) scale its increment by dt / dt_last, at most this
+ *  much: algorithm 2's ramp multiplies dt by up to 64, and after a short
+ *  step (a landing on a mass crossing) Newton's error in its increment
+ *  would be amplified by the ratio. */
 #define SP_PREDICTOR_MAX_RATIO 2.0
+
+/** How far ahead of t^n an extrapolation from the last step reaches for a
+ *  step of length dt. */
+static double extrapolation_dt(const sp_run *run, double dt) {
+  return run->hist.n >= 1 ? fmin(dt, SP_PREDICTOR_MAX_RATIO * run->hist.dt[0]) : dt;
+}
 
 void sp_step_begin(sp_run *run) {
   if (run->restarted) sp_dt_resume(&run->dtc, &run->opt.time.dt); /* state: the checkpoint's */
@@ -38,8 +47,9 @@ static int shape_on(const sp_run_terms *terms) {
 
 /** The step's source and shape coefficients from c^n (the state before the
  *  step and its observables). The source's indicator of a BDF2 step is
- *  taken at c extrapolated linearly to t^n + dt (into state_eff, which the
- *  step's c_hat overwrites next): from c^n it would lag the moving
+ *  taken at c extrapolated linearly to t^n + dt (at most twice the last
+ *  step ahead, as the predictor; into state_eff, which the step's c_hat
+ *  overwrites next): from c^n it would lag the moving
  *  interface by a step, a first-order error in each cell's mass that the
  *  error estimate cannot see (docs/time-stepping.md). */
 static int explicit_terms(sp_run *run, sp_scheme_kind kind, double dt) {
@@ -49,7 +59,7 @@ static int explicit_terms(sp_run *run, sp_scheme_kind kind, double dt) {
   if (terms->source_rate > 0) {
     const double *at = run->buf.state_old;
     if (kind == SP_SCHEME_BDF2 && terms->source_extrapolated) {
-      sp_scheme_extrapolate(1, &run->hist, dt, run->buf.state_old,
+      sp_scheme_extrapolate(1, &run->hist, extrapolation_dt(run, dt), run->buf.state_old,
                             (size_t)run->layout->n_pairs, run->buf.state_eff);
       at = run->buf.state_eff;
     }
@@ -133,10 +143,8 @@ int sp_step_try(sp_run *run, sp_step_attempt *a) {
   a->t_new = a->lands ? t_event : run->t + a->dt;
   memcpy(run->buf.state_old, run->state, n_values * sizeof(double));
   if (run->opt.time.predictor_linear) /* Newton starts from the extrapolation */
-    sp_scheme_extrapolate(1, &run->hist,
-                          run->hist.n >= 1 ? fmin(a->dt, SP_PREDICTOR_MAX_RATIO * run->hist.dt[0])
-                                           : a->dt,
-                          run->buf.state_old, n_pairs, run->state);
+    sp_scheme_extrapolate(1, &run->hist, extrapolation_dt(run, a->dt), run->buf.state_old,
+                          n_pairs, run->state);
   const sp_scheme_kind kind = sp_scheme_of_step(run->opt.time.scheme, &run->hist);
   int rc = explicit_terms(run, kind, a->dt);
   if (rc == SP_OK) rc = sp_fault_check(SP_FAULT_STEP, run->rank);
