@@ -209,6 +209,28 @@ static inline int cells_column(const char *dir, const char *name, double *v, int
   return steps;
 }
 
+/* The largest relative energy difference between two runs' energy.csv
+ * (which must have the same steps at the same t). */
+static inline double energy_difference(const char *a_dir, const char *b_dir) {
+  char pa[512], pb[512];
+  snprintf(pa, sizeof pa, "%s/energy.csv", a_dir);
+  snprintf(pb, sizeof pb, "%s/energy.csv", b_dir);
+  csv_table a, b;
+  CHECK(csv_read(pa, &a) == 0 && csv_read(pb, &b) == 0, "%s or %s unreadable", pa, pb);
+  CHECK(a.n_rows == b.n_rows, "%d rows against %d", a.n_rows, b.n_rows);
+  double worst = 0;
+  for (int i = 0; i < a.n_rows && i < b.n_rows; ++i) {
+    CHECK(fabs(at(&a, i, "t") - at(&b, i, "t")) <= 1e-15, "row %d: t %.17g against %.17g", i,
+          at(&a, i, "t"), at(&b, i, "t"));
+    CHECK(at(&a, i, "n_cells") == at(&b, i, "n_cells"), "row %d: cells differ", i);
+    const double ea = at(&a, i, "energy"), eb = at(&b, i, "energy");
+    worst = fmax(worst, fabs(ea - eb) / fabs(ea));
+  }
+  free(a.v);
+  free(b.v);
+  return worst;
+}
+
 /* The whole file as a string (NULL if unreadable); its length in *len. */
 static inline char *slurp(const char *path, size_t *len) {
   FILE *f = fopen(path, "rb");

@@ -30,28 +30,6 @@ static sp_run_summary run(const char *scene_file, const char *predictor, const c
   return sum;
 }
 
-/* The largest relative energy difference between two runs' energy.csv
- * (which must have the same steps at the same t). */
-static double energy_difference(const char *a_dir, const char *b_dir) {
-  char pa[512], pb[512];
-  snprintf(pa, sizeof pa, "%s/energy.csv", a_dir);
-  snprintf(pb, sizeof pb, "%s/energy.csv", b_dir);
-  csv_table a, b;
-  CHECK(csv_read(pa, &a) == 0 && csv_read(pb, &b) == 0, "%s or %s unreadable", pa, pb);
-  CHECK(a.n_rows == b.n_rows, "%d rows against %d", a.n_rows, b.n_rows);
-  double worst = 0;
-  for (int i = 0; i < a.n_rows && i < b.n_rows; ++i) {
-    CHECK(fabs(at(&a, i, "t") - at(&b, i, "t")) <= 1e-15, "row %d: t %.17g against %.17g", i,
-          at(&a, i, "t"), at(&b, i, "t"));
-    CHECK(at(&a, i, "n_cells") == at(&b, i, "n_cells"), "row %d: cells differ", i);
-    const double ea = at(&a, i, "energy"), eb = at(&b, i, "energy");
-    worst = fmax(worst, fabs(ea - eb) / fabs(ea));
-  }
-  free(a.v);
-  free(b.v);
-  return worst;
-}
-
 /* Cell k's mass and centre at the last step of out/cells.csv. */
 static void last_cells(const char *dir, int n, double *m, double *x, double *y) {
   char path[512];
