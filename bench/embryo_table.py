@@ -20,9 +20,22 @@ units the scene names: um, min) and prints, in Markdown:
     against the atlas", says what was searched; the column prints "-"),
     and TOUCHES whether the pair touches in the embryo where a source says
     so (the 4-cell "diamond": ABa does not touch P2, the other five pairs
-    do; Giammona and Campas 2021, PLoS Comput Biol 17:e1007994, Fig 1A).
+    do; Giammona and Campas 2021, PLoS Comput Biol 17:e1007994, Fig 1A);
+  - the arrangement of those stages: each cell's centre (cells.csv) and, for
+    every pair, the distance between the centres and, when the run wrote
+    that step's fields (OUT_DIR/fields_<step>.vtu, one process), the gap:
+    the smallest distance between a mesh node where c_k >= 1/2 and one where
+    c_l >= 1/2. Two cells pressed together have a gap of about one element
+    (their c = 1/2 surfaces meet between nodes); cells with a third one
+    between them, its width. A test of touching that does not read the
+    diffuse fields' gradients far from the membranes, as the contact
+    measure does (docs/embryo.md, "3D at refinements 3").
 """
+import base64
 import csv
+import math
+import re
+import struct
 import sys
 from collections import defaultdict
 
@@ -31,7 +44,8 @@ ATLAS = {"P0": 20769, "AB": 12304, "P1": 8465, "ABa": 6195, "ABp": 6109, "EMS": 
          "E": 2249, "C": 2368, "P3": 1157}
 
 # Published contact fractions by pair (frozenset of names): none could be
-# cited (docs/embryo.md, "Contacts against the atlas").
+# cited after two searches (docs/embryo.md, "Contacts against the atlas",
+# which also quotes an unpublished one-embryo reading that is not put here).
 PUBLISHED = {}
 
 # Whether a pair touches in the embryo, where a source says so: the 4-cell
@@ -105,6 +119,58 @@ def main(out):
             print(f"| {names[k]}-{names[l]} | {c:.1f} {cunit} | {a / surface[k]:.3f} "
                   f"| {a / surface[l]:.3f} | {'-' if published is None else published} "
                   f"| {TOUCHES.get(pair, '-')} |")
+        arrangement(out, step, rows, conv)
+
+
+def arrangement(out, step, rows, conv):
+    """The stage's centres, and each pair's centre distance and gap."""
+    axes = [a for a in ("xc", "yc", "zc") if a in rows[0]]
+    centre = {}
+    print(f"\n| cell | {' | '.join(a[0] for a in axes)} |")
+    print("|---|" + "---|" * len(axes))
+    for r in sorted(rows, key=lambda r: r["name"]):
+        centre[r["name"]] = [conv("cells.csv", a, float(r[a]))[0] for a in axes]
+        unit = conv("cells.csv", axes[0], 0.0)[1]
+        print(f"| {r['name']} | " + " | ".join(f"{v:.2f} {unit}" for v in centre[r["name"]])
+              + " |")
+    fields = read_vtu_fields(f"{out}/fields_{step:06d}.vtu")
+    print("\n| pair | centre distance | gap (c >= 1/2) |")
+    print("|---|---|---|")
+    ordered = sorted(rows, key=lambda r: r["name"])
+    inside = {}
+    if fields is not None:
+        points, c = fields
+        scale = conv("cells.csv", axes[0], 1.0)[0]
+        for r in ordered:
+            inside[r["name"]] = [points[i] for i, v in enumerate(c[f"c_{r['cell']}"]) if v >= 0.5]
+    for i, p in enumerate(ordered):
+        for q in ordered[i + 1:]:
+            d = math.dist(centre[p["name"]], centre[q["name"]])
+            gap = "-"
+            if inside.get(p["name"]) and inside.get(q["name"]):
+                g = min(math.dist(a, b) for a in inside[p["name"]] for b in inside[q["name"]])
+                gap = f"{g * scale:.1f} {unit}"
+            print(f"| {p['name']}-{q['name']} | {d:.1f} {unit} | {gap} |")
+
+
+def read_vtu_fields(path):
+    """The points and the Float64 point arrays c_<k> (by name) of a .vtu
+    softpack wrote (inline base64 with a UInt64 byte count); None when the
+    file is not there."""
+    if not _exists(path):
+        return None
+    with open(path) as f:
+        text = f.read()
+
+    def array(data):
+        raw = base64.b64decode("".join(data.split()))
+        n = struct.unpack_from("<Q", raw)[0] // 8
+        return struct.unpack_from(f"<{n}d", raw, 8)
+    c = {name: array(data) for name, data in
+         re.findall(r'<DataArray type="Float64" Name="(c_\d+)" format="binary">\s*([^<]*)<', text)}
+    xyz = array(re.search(r'<DataArray type="Float64" Name="Points" NumberOfComponents="3" '
+                          r'format="binary">\s*([^<]*)<', text).group(1))
+    return [xyz[i:i + 3] for i in range(0, len(xyz), 3)], c
 
 
 def _exists(path):
