@@ -132,14 +132,8 @@ static int from_checkpoint(sp_run *run, const sp_scene *scene, const sp_run_star
 /** The initial fields cut to the initial supports: background and noise
  *  exist only there (docs/local-support.md). */
 static int cut_to_supports(sp_run *run) {
-  const int n = run->layout->n_cells;
-  unsigned char *mask;
-  SP_ALLOC(mask, (size_t)run->mesh->n_nodes * n);
   sp_layout *layout = NULL;
-  int rc = sp_support_masks(run->support, run->layout, run->state, mask);
-  if (rc == SP_OK) rc = sp_support_layout_from_masks(run->support, n, mask, &layout);
-  free(mask);
-  SP_CALL(rc);
+  SP_CALL(sp_support_initial(run->support, run->layout, run->state, &layout));
   double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
   if (!state) {
     sp_layout_destroy(&layout);

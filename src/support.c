@@ -552,6 +552,41 @@ static int rebuild_widened(sp_support s, const sp_layout *layout, const double *
   return rc;
 }
 
+int sp_support_initial(sp_support s, const sp_layout *layout, const double *state,
+                       sp_layout **out) {
+  const int nc = layout->n_cells;
+  int *layers;
+  SP_ALLOC(layers, nc ? nc : 1);
+  double *cut = NULL;
+  int rc = SP_OK, outgrown = 1;
+  *out = NULL;
+  /* as sp_support_rebuild: a support that would call for an update at
+   * once (an element wider than margin - band, docs/local-support.md
+   * "Coarse meshes") is widened by layers of elements until none would;
+   * the fields are cut to the supports, not filled */
+  while (rc == SP_OK && outgrown) {
+    sp_layout_destroy(out);
+    free(cut);
+    cut = NULL;
+    rc = widened_layout(s, layout, state, NULL, layers, out);
+    if (rc == SP_OK && !(cut = malloc(2 * sizeof(double) * (size_t)(*out)->n_pairs + 1)))
+      rc = sp_error_set(SP_ERR_MEMORY, "supports: out of memory");
+    if (rc == SP_OK) sp_layout_transfer(layout, state, *out, cut, 0.0);
+    const sp_cell_pairs *cp;
+    if (rc == SP_OK) rc = sp_layout_cells(*out, &cp);
+    outgrown = 0;
+    for (int k = 0; k < nc && rc == SP_OK; ++k)
+      if (cell_needs_update(s, *out, cp, cut, k)) {
+        ++layers[k];
+        outgrown = 1;
+      }
+  }
+  free(cut);
+  free(layers);
+  if (rc != SP_OK) sp_layout_destroy(out);
+  return rc;
+}
+
 int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *state,
                        const unsigned char *may_shrink, sp_layout **new_layout,
                        double **new_state, double *mass_correction, double *mass_dropped) {

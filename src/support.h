@@ -53,8 +53,8 @@ int sp_support_create(const sp_mesh *mesh, const sp_support_params *params,
  * @brief Support masks of every cell from its field: mask[k * n_nodes + i]
  *        is 1 when node i is in cell k's support. A cell with an empty core
  *        keeps its current support (so it cannot vanish). Writes
- *        cells x nodes bytes: for the set-up (sp_support_layout is the
- *        per-step path).
+ *        cells x nodes bytes (tests; the set-up takes sp_support_initial,
+ *        a step sp_support_rebuild).
  */
 int sp_support_masks(sp_support s, const sp_layout *layout,
                      const double *state, unsigned char *mask);
@@ -111,12 +111,21 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout,
  * @brief The supports computed from the fields (sp_support_masks' rule;
  *        with may_shrink[k] = 0 the union with cell k's current support),
  *        closed to whole elements, as a new layout. Costs the pairs and the
- *        nodes the searches reach, not cells x nodes (an accepted step's
- *        path; the masks are the set-up's).
+ *        nodes the searches reach, not cells x nodes.
  * @param[in] may_shrink n_cells flags (NULL: every cell may shrink)
  */
 int sp_support_layout(sp_support s, const sp_layout *layout, const double *state,
                       const unsigned char *may_shrink, sp_layout **out);
+
+/**
+ * @brief The set-up's supports: sp_support_layout's from the fields on
+ *        @p layout (every cell may shrink), each cell's widened by layers
+ *        of elements while, with the fields cut to it, it would call for
+ *        an update at once (as sp_support_rebuild widens; coarse meshes),
+ *        so the first step does not change them again.
+ */
+int sp_support_initial(sp_support s, const sp_layout *layout, const double *state,
+                       sp_layout **out);
 
 /** @brief Layout from per-cell masks, with every cell's mask closed to
  *         whole elements (no node without a whole element of its cell). */
