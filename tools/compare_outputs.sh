@@ -3,6 +3,7 @@
 # tests/scenes/ with two softpack binaries and compare what they write.
 #
 #   tools/compare_outputs.sh OLD_SOFTPACK NEW_SOFTPACK [NP...] [-- SCENE...]
+#   tools/compare_outputs.sh --cut     (prints the table: "SCENE STEPS" lines)
 #
 # NP: the process counts to compare on (default "1 2"); on more than one
 # process every run uses solver.linear=superlu_dist, which is bitwise
@@ -16,15 +17,6 @@
 # COMPARE_CACHE=DIR keeps OLD's outputs in DIR and reuses them when there
 # (for a series of comparisons against one baseline binary).
 set -uo pipefail
-old=$1 new=$2
-shift 2
-nps=()
-while [ $# -gt 0 ] && [ "$1" != "--" ]; do nps+=("$1"); shift; done
-[ "${1:-}" = "--" ] && shift
-[ ${#nps[@]} -eq 0 ] && nps=(1 2)
-cd "$(dirname "$0")/.."
-export OMP_NUM_THREADS=1
-
 # scene -> steps: past the first division and the first support change
 declare -A cut=(
   [inputs/default.yaml]=30
@@ -56,6 +48,20 @@ declare -A cut=(
   [tests/scenes/restart_grow.yaml]=60
   [tests/scenes/two_overlapping.yaml]=20
 )
+# (the table alone: tools/compare_tolerance_all.sh cuts the scenes alike)
+if [ "${1:-}" = --cut ]; then
+  for scene in $(printf '%s\n' "${!cut[@]}" | sort); do echo "$scene ${cut[$scene]}"; done
+  exit 0
+fi
+old=$1 new=$2
+shift 2
+nps=()
+while [ $# -gt 0 ] && [ "$1" != "--" ]; do nps+=("$1"); shift; done
+[ "${1:-}" = "--" ] && shift
+[ ${#nps[@]} -eq 0 ] && nps=(1 2)
+cd "$(dirname "$0")/.."
+export OMP_NUM_THREADS=1
+
 scenes=("$@")
 [ ${#scenes[@]} -eq 0 ] && scenes=($(printf '%s\n' "${!cut[@]}" | sort))
 
