@@ -100,7 +100,8 @@ class StepModel : public Thyra::StateFuncModelEvaluatorBase<double> {
   void evalModelImpl(const Thyra::ModelEvaluatorBase::InArgs<double> &in,
                      const Thyra::ModelEvaluatorBase::OutArgs<double> &out) const override {
     const double *x = local(*in.get_x());
-    if (const auto f = out.get_f(); !f.is_null()) s_.fill_residual(data(), x, local(*f));
+    if (const auto f = out.get_f(); !f.is_null())  // (assembled into NOX's vector itself)
+      s_.fill_residual(data(), x, *Extract::getTpetraVector(f));
     if (!out.get_W_op().is_null() && !s_.may_reuse_jacobian())  // (else keep matrix and factors)
       s_.fill_jacobian(data(), x);
   }
@@ -500,7 +501,6 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   agree_local(comm_, [&] {  // (the gathers below are collective)
     jacobian_matrix_ = Teuchos::rcp(new TpetraMatrix(assembly_->graph()));
     jacobian_matrix_->fillComplete(assembly_->map(), assembly_->map());
-    residual_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
     apply_in_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
     apply_out_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
     build_nox_solve();
@@ -596,11 +596,10 @@ void copy_into(const double *in, TpetraVector &v) {
 
 }  // namespace
 
-void Solver::fill_residual(const sp_step_data &d, const double *x, double *F) {
+void Solver::fill_residual(const sp_step_data &d, const double *x, TpetraVector &F) {
   double t0 = now();
   gather(x, full_);
-  assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), *residual_);
-  copy_from(*residual_, F);
+  assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), F);
   t_assembly_ += now() - t0;
 }
 
