@@ -2,11 +2,13 @@
 # Per-step cost of two softpack binaries on one scene (issue 31: the
 # Newton solve on NOX-Epetra, then on NOX-Thyra): ROUNDS rounds, each
 # running OLD and NEW at the same time (one process each: on a machine
-# shared with other work both see the same load at the same moments); the phases summed over the accepted and rejected steps of
-# energy.csv (assembly_s, factorisation_s, solves_s, seconds), the median
-# over rounds per binary, and NEW / OLD per phase, of the medians and of
-# the minima (the run least slowed by other work on a shared machine). Also says whether the
-# two wrote the same energy.csv (without the clock columns).
+# shared with other work both see the same load at the same moments).
+# Per run the phases are summed over energy.csv's rows (assembly_s,
+# factorisation_s, solves_s, seconds); printed: per binary the median and
+# the minimum over the rounds (the minimum is the run least slowed by
+# other work), and NEW / OLD of each. Also says whether the first round's
+# two runs wrote the same energy.csv columns 1-11 (steps, t, dt, Newton
+# iterations, cells, the energy and its parts).
 #   bench/binaries_ab.sh OLD_SOFTPACK NEW_SOFTPACK SCENE ROUNDS [--set k=v ...]
 set -uo pipefail
 old=$1 new=$2 scene=$3 rounds=$4
@@ -28,7 +30,7 @@ for r in $(seq "$rounds"); do
 done
 same=yes
 cut -d, -f1-11 "$out/old1/energy.csv" | cmp -s - <(cut -d, -f1-11 "$out/new1/energy.csv") || same=no
-echo "$scene $* ($rounds rounds, steps $(($(wc -l < "$out/new1/energy.csv") - 2)), energy.csv t/dt/energy columns identical: $same)"
+echo "$scene $* ($rounds rounds, steps $(($(wc -l < "$out/new1/energy.csv") - 2)), energy.csv columns 1-11 identical: $same)"
 awk '{ n[$1]++; for (k = 2; k <= 5; ++k) v[$1, n[$1], k] = $k }
   function sorted(w, k, x,   m, i, j, t) {
     m = n[w]; for (i = 1; i <= m; ++i) x[i] = v[w, i, k]
