@@ -130,12 +130,10 @@ class JacobianSolve : public Thyra::LinearOpWithSolveBase<double> {
   bool opSupportedImpl(Thyra::EOpTransp t) const override {
     return t == Thyra::NOTRANS || t == Thyra::TRANS;
   }
-  // Y = alpha op(J) X + beta Y
+  // Y = alpha op(J) X + beta Y (NOX's applyJacobian and its transpose)
   void applyImpl(Thyra::EOpTransp t, const ThyraMV &X, const Teuchos::Ptr<ThyraMV> &Y,
                  double alpha, double beta) const override {
-    const size_t n = X.range()->dim() ? Extract::getConstTpetraMultiVector(
-                                            Teuchos::rcpFromRef(X))->getLocalLength()
-                                      : 0;
+    const size_t n = Extract::getConstTpetraMultiVector(Teuchos::rcpFromRef(X))->getLocalLength();
     std::vector<double> JX(n);
     for (int j = 0; j < X.domain()->dim(); ++j) {
       s_.apply_jacobian(local(X, j), JX.data(), t != Thyra::NOTRANS);
