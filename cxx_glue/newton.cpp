@@ -1,21 +1,19 @@
 #include "newton.hpp"
 
-#include <Epetra_Map.h>
-#include <Epetra_MpiComm.h>
-#include <Epetra_Vector.h>
 #include <NOX.H>
-#include <NOX_Epetra_Group.H>
-#include <NOX_Epetra_Interface_Jacobian.H>
-#include <NOX_Epetra_Interface_Required.H>
-#include <NOX_Epetra_LinearSystem.H>
-#include <NOX_Epetra_Vector.H>
 #include <NOX_Observer.hpp>
 #include <NOX_StatusTest_Combo.H>
 #include <NOX_StatusTest_Divergence.H>
 #include <NOX_StatusTest_FiniteValue.H>
 #include <NOX_StatusTest_MaxIters.H>
 #include <NOX_StatusTest_NormF.H>
+#include <NOX_Thyra_Group.H>
+#include <NOX_Thyra_Vector.H>
 #include <Teuchos_ParameterList.hpp>
+#include <Thyra_LinearOpWithSolveBase.hpp>
+#include <Thyra_LinearOpWithSolveFactoryBase.hpp>
+#include <Thyra_StateFuncModelEvaluatorBase.hpp>
+#include <Thyra_TpetraThyraWrappers.hpp>
 #include <Tpetra_CrsMatrix.hpp>
 #include <Tpetra_Vector.hpp>
 
@@ -38,99 +36,155 @@ double now() {
   return duration<double>(steady_clock::now().time_since_epoch()).count();
 }
 
-// NOX's callbacks: residual and Jacobian of the current step's equations.
-// Built once per layout with the group; Solver::step points it at its
-// sp_step_data for the length of the step (Scope). NOX's Epetra vectors and
-// the assembly's Tpetra objects have the same rows in the same local order
-// (Assembly::my_rows()): Solver copies the local arrays across.
-class StepInterface : public NOX::Epetra::Interface::Required,
-                      public NOX::Epetra::Interface::Jacobian {
+// NOX's vectors are Thyra vectors on Tpetra ones (Thyra::TpetraVector)
+// over the assembly's row map, so their local arrays are this rank's rows
+// in Assembly::my_rows() order: Solver works on those arrays directly.
+using ThyraSpace = Thyra::VectorSpaceBase<double>;
+using ThyraMV = Thyra::MultiVectorBase<double>;
+using Extract = Thyra::TpetraOperatorVectorExtraction<double, int, GlobalId>;
+
+// The local array of column j of a Thyra multivector on Tpetra (NOX's
+// vectors are one column; the Tpetra vector outlives the pointer).
+const double *local(const ThyraMV &v, int j = 0) {
+  const auto t = Extract::getConstTpetraMultiVector(Teuchos::rcpFromRef(v));
+  return t->getLocalViewHost(Tpetra::Access::ReadOnly).data() + j * t->getStride();
+}
+double *local(ThyraMV &v, int j = 0) {
+  const auto t = Extract::getTpetraMultiVector(Teuchos::rcpFromRef(v));
+  return t->getLocalViewHost(Tpetra::Access::ReadWrite).data() + j * t->getStride();
+}
+double *local(NOX::Abstract::Vector &v) {
+  return local(dynamic_cast<NOX::Thyra::Vector &>(v).getThyraVector());
+}
+const double *local(const NOX::Abstract::Vector &v) {
+  return local(dynamic_cast<const NOX::Thyra::Vector &>(v).getThyraVector());
+}
+
+// NOX's model of a step's equations (a Thyra ModelEvaluator): F(x) and
+// the Jacobian at x into the operator NOX passes (JacobianSolve, which
+// stands for Solver's matrix). Built once per layout with the group;
+// Solver::step points it at its sp_step_data for the length of the step
+// (Scope). Under modified Newton (jacobian_reuse) a Jacobian NOX asks for
+// is not filled while the factorisation may be kept (may_reuse_jacobian).
+class StepModel : public Thyra::StateFuncModelEvaluatorBase<double> {
  public:
-  explicit StepInterface(Solver &s) : s_(s) {}
-  bool computeF(const Epetra_Vector &x, Epetra_Vector &F, FillType) override {
-    s_.fill_residual(data(), x.Values(), F.Values());
-    return true;
-  }
-  bool computeJacobian(const Epetra_Vector &x, Epetra_Operator &) override { return jacobian(x); }
-  bool jacobian(const Epetra_Vector &x) {
-    s_.fill_jacobian(data(), x.Values());
-    return true;
+  StepModel(Solver &s, Teuchos::RCP<const ThyraSpace> space) : s_(s), space_(std::move(space)) {}
+  Teuchos::RCP<const ThyraSpace> get_x_space() const override { return space_; }
+  Teuchos::RCP<const ThyraSpace> get_f_space() const override { return space_; }
+  Thyra::ModelEvaluatorBase::InArgs<double> createInArgs() const override {
+    Thyra::ModelEvaluatorBase::InArgsSetup<double> in;
+    in.setModelEvalDescription("softpack step");
+    in.setSupports(Thyra::ModelEvaluatorBase::IN_ARG_x);
+    return std::move(in);
   }
   // Points the callbacks at d until the scope ends.
   class Scope {
    public:
-    Scope(StepInterface &i, const sp_step_data &d) : i_(i) { i_.d_ = &d; }
-    ~Scope() { i_.d_ = nullptr; }
+    Scope(StepModel &m, const sp_step_data &d) : m_(m) { m_.d_ = &d; }
+    ~Scope() { m_.d_ = nullptr; }
     Scope(const Scope &) = delete;
     Scope &operator=(const Scope &) = delete;
 
    private:
-    StepInterface &i_;
+    StepModel &m_;
   };
 
  private:
+  Thyra::ModelEvaluatorBase::OutArgs<double> createOutArgsImpl() const override {
+    Thyra::ModelEvaluatorBase::OutArgsSetup<double> out;
+    out.setModelEvalDescription("softpack step");
+    out.setSupports(Thyra::ModelEvaluatorBase::OUT_ARG_f);
+    out.setSupports(Thyra::ModelEvaluatorBase::OUT_ARG_W_op);
+    return std::move(out);
+  }
+  void evalModelImpl(const Thyra::ModelEvaluatorBase::InArgs<double> &in,
+                     const Thyra::ModelEvaluatorBase::OutArgs<double> &out) const override {
+    const double *x = local(*in.get_x());
+    if (const auto f = out.get_f(); !f.is_null())  // (assembled into NOX's vector itself)
+      s_.fill_residual(data(), x, *Extract::getTpetraVector(f));
+    if (!out.get_W_op().is_null() && !s_.may_reuse_jacobian())  // (else keep matrix and factors)
+      s_.fill_jacobian(data(), x);
+  }
   const sp_step_data &data() const {
     if (!d_) throw std::logic_error("NOX evaluated the step equations outside a step");
     return *d_;
   }
   Solver &s_;
+  Teuchos::RCP<const ThyraSpace> space_;
   const sp_step_data *d_ = nullptr;
 };
 
-// NOX's hook for a direct solver: J is assembled by StepInterface and
-// factored here; there is no preconditioner. J is a Tpetra matrix, which
-// NOX::Epetra does not see: getJacobianOperator() gives none, and NOX
-// hands that back to setJacobianOperatorForSolve(), which ignores it.
-class DirectLinearSystem : public NOX::Epetra::LinearSystem {
+// The Jacobian as NOX sees it, both as the operator the model fills (W_op)
+// and as the operator with a solve: apply is Solver::apply_jacobian (the
+// sparse matrix plus the implicit shape term's low-rank part), solve is
+// Solver::solve_linear, which factors the matrix first if it was filled
+// since the last factorisation. There is no preconditioner.
+class JacobianSolve : public Thyra::LinearOpWithSolveBase<double> {
  public:
-  DirectLinearSystem(Solver &s, StepInterface &i) : s_(s), i_(i) {}
-  bool applyJacobian(const NOX::Epetra::Vector &in, NOX::Epetra::Vector &out) const override {
-    return s_.apply_jacobian(in.getEpetraVector().Values(), out.getEpetraVector().Values(),
-                             false);
+  JacobianSolve(Solver &s, Teuchos::RCP<const ThyraSpace> space)
+      : s_(s), space_(std::move(space)) {}
+  Teuchos::RCP<const ThyraSpace> range() const override { return space_; }
+  Teuchos::RCP<const ThyraSpace> domain() const override { return space_; }
+
+ protected:
+  bool opSupportedImpl(Thyra::EOpTransp t) const override {
+    return t == Thyra::NOTRANS || t == Thyra::TRANS;
   }
-  bool applyJacobianTranspose(const NOX::Epetra::Vector &in,
-                              NOX::Epetra::Vector &out) const override {
-    return s_.apply_jacobian(in.getEpetraVector().Values(), out.getEpetraVector().Values(),
-                             true);
+  // Y = alpha op(J) X + beta Y (NOX's applyJacobian and its transpose)
+  void applyImpl(Thyra::EOpTransp t, const ThyraMV &X, const Teuchos::Ptr<ThyraMV> &Y,
+                 double alpha, double beta) const override {
+    const size_t n = Extract::getConstTpetraMultiVector(Teuchos::rcpFromRef(X))->getLocalLength();
+    std::vector<double> JX(n);
+    for (int j = 0; j < X.domain()->dim(); ++j) {
+      s_.apply_jacobian(local(X, j), JX.data(), t != Thyra::NOTRANS);
+      double *y = local(*Y, j);
+      for (size_t i = 0; i < n; ++i) y[i] = alpha * JX[i] + (beta == 0 ? 0.0 : beta * y[i]);
+    }
   }
-  bool applyJacobianInverse(Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
-                            NOX::Epetra::Vector &out) override {
-    return s_.solve_linear(in.getEpetraVector().Values(), out.getEpetraVector().Values());
+  Thyra::SolveStatus<double> solveImpl(Thyra::EOpTransp t, const ThyraMV &B,
+                                       const Teuchos::Ptr<ThyraMV> &X,
+                                       const Teuchos::Ptr<const Thyra::SolveCriteria<double>>)
+      const override {
+    if (t != Thyra::NOTRANS) throw std::logic_error("NOX asked for a transposed solve");
+    // A failed solve (the reason kept by Solver): NOX's Newton direction
+    // throws, as it did with NOX::Epetra.
+    Thyra::SolveStatus<double> status;
+    status.solveStatus = Thyra::SOLVE_STATUS_CONVERGED;
+    for (int j = 0; j < B.domain()->dim(); ++j)
+      if (!s_.solve_linear(local(B, j), local(*X, j)))
+        status.solveStatus = Thyra::SOLVE_STATUS_UNKNOWN;
+    return status;
   }
-  bool applyRightPreconditioning(bool, Teuchos::ParameterList &, const NOX::Epetra::Vector &in,
-                                 NOX::Epetra::Vector &out) const override {
-    out = in;
-    return true;
-  }
-  Teuchos::RCP<NOX::Epetra::Scaling> getScaling() override { return Teuchos::null; }
-  void resetScaling(const Teuchos::RCP<NOX::Epetra::Scaling> &) override {}
-  bool computeJacobian(const NOX::Epetra::Vector &x) override {
-    if (s_.may_reuse_jacobian()) return true;  // keep matrix and factors
-    return i_.jacobian(x.getEpetraVector());
-  }
-  bool createPreconditioner(const NOX::Epetra::Vector &, Teuchos::ParameterList &,
-                            bool) const override { return false; }
-  bool destroyPreconditioner() const override { return false; }
-  bool recomputePreconditioner(const NOX::Epetra::Vector &,
-                               Teuchos::ParameterList &) const override { return false; }
-  PreconditionerReusePolicyType getPreconditionerPolicy(bool) override { return PRPT_REBUILD; }
-  bool isPreconditionerConstructed() const override { return false; }
-  bool hasPreconditioner() const override { return false; }
-  Teuchos::RCP<const Epetra_Operator> getJacobianOperator() const override {
-    return Teuchos::null;
-  }
-  Teuchos::RCP<Epetra_Operator> getJacobianOperator() override { return Teuchos::null; }
-  Teuchos::RCP<const Epetra_Operator> getGeneratedPrecOperator() const override {
-    return Teuchos::null;
-  }
-  Teuchos::RCP<Epetra_Operator> getGeneratedPrecOperator() override { return Teuchos::null; }
-  // NOX hands back the same matrix before every solve: nothing to drop.
-  void setJacobianOperatorForSolve(const Teuchos::RCP<const Epetra_Operator> &) override {}
-  void setPrecOperatorForSolve(const Teuchos::RCP<const Epetra_Operator> &) override {}
 
  private:
   Solver &s_;
-  StepInterface &i_;
+  Teuchos::RCP<const ThyraSpace> space_;
+};
+
+// Hands NOX the one JacobianSolve: "initialising" it with the operator NOX
+// just had filled changes nothing (Solver knows whether the matrix changed
+// since its last factorisation: the carry and jacobian_reuse decide there).
+class JacobianSolveFactory : public Thyra::LinearOpWithSolveFactoryBase<double> {
+ public:
+  explicit JacobianSolveFactory(Teuchos::RCP<JacobianSolve> op) : op_(std::move(op)) {}
+  bool isCompatible(const Thyra::LinearOpSourceBase<double> &) const override { return true; }
+  Teuchos::RCP<Thyra::LinearOpWithSolveBase<double>> createOp() const override { return op_; }
+  void initializeOp(const Teuchos::RCP<const Thyra::LinearOpSourceBase<double>> &,
+                    Thyra::LinearOpWithSolveBase<double> *,
+                    Thyra::ESupportSolveUse) const override {}
+  void uninitializeOp(Thyra::LinearOpWithSolveBase<double> *,
+                      Teuchos::RCP<const Thyra::LinearOpSourceBase<double>> *,
+                      Teuchos::RCP<const Thyra::PreconditionerBase<double>> *,
+                      Teuchos::RCP<const Thyra::LinearOpSourceBase<double>> *,
+                      Thyra::ESupportSolveUse *) const override {}
+  void setParameterList(const Teuchos::RCP<Teuchos::ParameterList> &) override {}
+  Teuchos::RCP<Teuchos::ParameterList> getNonconstParameterList() override {
+    return Teuchos::null;
+  }
+  Teuchos::RCP<Teuchos::ParameterList> unsetParameterList() override { return Teuchos::null; }
+
+ private:
+  Teuchos::RCP<JacobianSolve> op_;
 };
 
 // Records ||F|| at the start and after every iteration (Solver::note_residual).
@@ -207,13 +261,12 @@ class UpdateSmall : public ConditionTest {
  protected:
   bool holds(const NOX::Solver::Generic &solver) const override {
     if (!(rtol_ > 0 || atol_ > 0) || solver.getNumIterations() < 1) return false;
-    const auto &x = dynamic_cast<const NOX::Epetra::Vector &>(solver.getSolutionGroup().getX())
-                        .getEpetraVector();
-    const auto &xp = dynamic_cast<const NOX::Epetra::Vector &>(
-                         solver.getPreviousSolutionGroup().getX()).getEpetraVector();
+    const auto &X = dynamic_cast<const NOX::Thyra::Vector &>(solver.getSolutionGroup().getX());
+    const double *x = local(X), *xp = local(solver.getPreviousSolutionGroup().getX());
+    const auto rows = Extract::getConstTpetraMultiVector(X.getThyraRCPVector())->getMap();
     double worst = 0;
-    for (int i = 0; i < x.MyLength(); ++i) {
-      if (x.Map().GID(i) % 2 != 0) continue;
+    for (size_t i = 0; i < rows->getNodeNumElements(); ++i) {
+      if (rows->getGlobalElement((int)i) % 2 != 0) continue;
       const double e = std::fabs(x[i] - xp[i]) / (atol_ + rtol_ * std::fabs(x[i]));
       worst = std::isnan(e) ? INFINITY : std::max(worst, e);  // (a NaN anywhere fails)
     }
@@ -283,13 +336,12 @@ struct Solver::Nox {
   Teuchos::RCP<UpdateSmall> update;           // the step's update tolerances
   Teuchos::RCP<RelativeDivergence> diverged;  // null: newton_divergence off
   int max_its = 0;
-  std::unique_ptr<Epetra_MpiComm> comm;  // NOX::Epetra's vectors' communicator
-  // Once per layout (set_problem): vectors on the layout's rows (an Epetra
-  // map of Assembly::my_rows()).
-  std::unique_ptr<Epetra_Map> map;
-  Teuchos::RCP<StepInterface> iface;
-  Teuchos::RCP<NOX::Epetra::Vector> guess;
-  Teuchos::RCP<NOX::Epetra::Group> group;
+  // Once per layout (set_problem): NOX's model of the step, the Jacobian
+  // it solves with, and vectors on the layout's rows (a Thyra vector space
+  // on the assembly's Tpetra map).
+  Teuchos::RCP<StepModel> model;
+  Teuchos::RCP<NOX::Thyra::Vector> guess;
+  Teuchos::RCP<NOX::Thyra::Group> group;
   Teuchos::RCP<NOX::Solver::Generic> solver;
 };
 
@@ -359,7 +411,6 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
   linear_ = std::make_unique<LowRankSolver>(comm, std::move(direct));
 
   nox_ = std::make_unique<Nox>();
-  nox_->comm = std::make_unique<Epetra_MpiComm>(comm);
   auto params = Teuchos::rcp(new Teuchos::ParameterList);
   params->set("Nonlinear Solver", "Line Search Based");
   // Backtrack: NOX's defaults (halve the step until the sum of squares of
@@ -420,14 +471,18 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
 void Solver::build_nox_solve() {
   Nox &n = *nox_;
   n.solver = Teuchos::null;  // (it holds the old group)
-  n.iface = Teuchos::rcp(new StepInterface(*this));
-  auto linsys = Teuchos::rcp(new DirectLinearSystem(*this, *n.iface));
-  const std::vector<GlobalId> &rows = assembly_->my_rows();
-  const std::vector<int> ids(rows.begin(), rows.end());  // (n_dofs < 2^31: Epetra's int ids)
-  n.map = std::make_unique<Epetra_Map>(-1, (int)ids.size(), ids.data(), 0, *n.comm);
-  n.guess = Teuchos::rcp(new NOX::Epetra::Vector(Epetra_Vector(*n.map)));
-  n.group = Teuchos::rcp(
-      new NOX::Epetra::Group(n.params->sublist("Printing"), n.iface, *n.guess, linsys));
+  const auto space = Thyra::createVectorSpace<double>(assembly_->map());
+  n.model = Teuchos::rcp(new StepModel(*this, space));
+  auto jacobian = Teuchos::rcp(new JacobianSolve(*this, space));
+  n.guess = Teuchos::rcp(new NOX::Thyra::Vector(Thyra::createMember(space)));
+  // (NOX's constructor for a given linear operator and solver factory; no
+  // preconditioner; the casts pick it among the overloads)
+  const Teuchos::RCP<Thyra::LinearOpBase<double>> op = jacobian;
+  const Teuchos::RCP<const Thyra::LinearOpWithSolveFactoryBase<double>> factory =
+      Teuchos::rcp(new JacobianSolveFactory(jacobian));
+  n.group = Teuchos::rcp(new NOX::Thyra::Group(
+      *n.guess, n.model, op, factory, Teuchos::RCP<Thyra::PreconditionerBase<double>>(),
+      Teuchos::RCP<Thyra::PreconditionerFactoryBase<double>>()));
   // (evaluates nothing: F is first computed in step)
   n.solver = NOX::Solver::buildSolver(n.group, n.tests, n.params);
 }
@@ -444,7 +499,6 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   agree_local(comm_, [&] {  // (the gathers below are collective)
     jacobian_matrix_ = Teuchos::rcp(new TpetraMatrix(assembly_->graph()));
     jacobian_matrix_->fillComplete(assembly_->map(), assembly_->map());
-    residual_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
     apply_in_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
     apply_out_ = Teuchos::rcp(new TpetraVector(assembly_->map()));
     build_nox_solve();
@@ -540,11 +594,10 @@ void copy_into(const double *in, TpetraVector &v) {
 
 }  // namespace
 
-void Solver::fill_residual(const sp_step_data &d, const double *x, double *F) {
+void Solver::fill_residual(const sp_step_data &d, const double *x, TpetraVector &F) {
   double t0 = now();
   gather(x, full_);
-  assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), *residual_);
-  copy_from(*residual_, F);
+  assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), F);
   t_assembly_ += now() - t0;
 }
 
@@ -697,8 +750,8 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   const double t_start = now();
   const long linear_its_before = linear_->iterations();
   Nox &n = *nox_;
-  const StepInterface::Scope scope(*n.iface, d);
-  scatter(state, n.guess->getEpetraVector().Values());
+  const StepModel::Scope scope(*n.model, d);
+  scatter(state, local(*n.guess));
 
   prepare_shape(d);
   // Carry the last step's factorisation: same layout, the last step
@@ -742,9 +795,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   report.t_factor = t_factor_;
   report.t_solve = t_solve_;
   if (status == Converged) {
-    const auto &xs = dynamic_cast<const NOX::Epetra::Vector &>(
-        n.solver->getSolutionGroup().getX()).getEpetraVector();
-    gather(xs.Values(), full_);
+    gather(local(n.solver->getSolutionGroup().getX()), full_);
     std::copy(full_.begin(), full_.end(), state);
     report.converged = 1;
     last_converged_ = true;

@@ -3,8 +3,9 @@
 // a low-rank part beside it), a linear solver for it, and NOX's Newton
 // solve of each time step's equations. What NOX needs is built ahead of the
 // steps (newton.cpp, Solver::Nox): the parameter list and the status tests
-// once per solver, the group and the NOX solver once per layout; a step
-// only loads its guess and its tolerances into them.
+// once per solver, the group (NOX::Thyra::Group over a Thyra model of the
+// step on Tpetra vectors) and the NOX solver once per layout; a step only
+// loads its guess and its tolerances into them.
 #ifndef SP_NEWTON_HPP
 #define SP_NEWTON_HPP
 
@@ -53,10 +54,11 @@ class Solver {
   double time_jacobian(const sp_step_data &data, const double *state, int kind,
                        int repeats, double *elements) const;
 
-  // Called by the NOX interface and linear system (newton.cpp), on this
-  // rank's rows (Assembly::my_rows(), in that order): NOX's vectors' local
-  // arrays, copied into and out of the Tpetra objects.
-  void fill_residual(const sp_step_data &data, const double *x, double *F);
+  // Called by NOX's model of the step and its Jacobian solve (newton.cpp),
+  // on this rank's rows (Assembly::my_rows(), in that order): the local
+  // arrays of NOX's vectors (Thyra vectors on Tpetra ones); F is NOX's
+  // residual vector's Tpetra vector, assembled into directly.
+  void fill_residual(const sp_step_data &data, const double *x, TpetraVector &F);
   void fill_jacobian(const sp_step_data &data, const double *x);
   // Solves J x = b (factoring J first if it changed); false: the reason is
   // kept for the step's report (a failed linear solve fails the attempt).
@@ -95,9 +97,9 @@ class Solver {
   void scatter(const double *x, double *mine) const;
 
   // The sparse part of J (declared first, so destroyed last), and vectors
-  // on its rows: the residual, Apply's input and output.
+  // on its rows: Apply's input and output.
   Teuchos::RCP<TpetraMatrix> jacobian_matrix_;
-  Teuchos::RCP<TpetraVector> residual_, apply_in_, apply_out_;
+  Teuchos::RCP<TpetraVector> apply_in_, apply_out_;
   // Why the current step's last linear solve failed (empty: none did).
   std::string linear_failure_;
   // Seconds of the current step: residual and Jacobian fills,

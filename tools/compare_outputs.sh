@@ -3,6 +3,12 @@
 # tests/scenes/ with two softpack binaries and compare what they write.
 #
 #   tools/compare_outputs.sh OLD_SOFTPACK NEW_SOFTPACK [NP...] [-- SCENE...]
+#   tools/compare_outputs.sh --tolerance OLD NEW [NP...] [-- SCENE...]
+#
+# --tolerance (tools/compare_tolerance_all.sh): the same runs compared by
+# tools/compare_tolerance.py instead of cmp (1e-10 relative in energy,
+# masses and centres, Newton iterations counted); both binaries run (no
+# cache).
 #
 # NP: the process counts to compare on (default "1 2"); on more than one
 # process every run uses solver.linear=superlu_dist, which is bitwise
@@ -16,6 +22,8 @@
 # COMPARE_CACHE=DIR keeps OLD's outputs in DIR and reuses them when there
 # (for a series of comparisons against one baseline binary).
 set -uo pipefail
+tolerance=
+[ "${1:-}" = --tolerance ] && { tolerance=" beyond the tolerance"; shift; }
 old=$1 new=$2
 shift 2
 nps=()
@@ -83,6 +91,13 @@ run_one() { # BINARY NP SCENE DIR
 failures=0
 for np in "${nps[@]}"; do
   for scene in "${scenes[@]}"; do
+    if [ -n "$tolerance" ]; then
+      sets=("time.max_steps=${cut[$scene]:-20}")
+      [ "$np" -gt 1 ] && sets+=(solver.linear=superlu_dist)
+      tools/compare_tolerance.py "$old" "$new" "$np" "$scene" "${sets[@]}" ||
+        failures=$((failures + 1))
+      continue
+    fi
     name=$(echo "$scene" | tr / _)
     a=$work/old_${np}_$name b=$work/new_${np}_$name
     if [ -n "${COMPARE_CACHE:-}" ]; then
@@ -121,5 +136,5 @@ for np in "${nps[@]}"; do
     [ "$verdict" = same ] || failures=$((failures + 1))
   done
 done
-echo "compare_outputs: $failures run(s) differ"
+echo "compare_outputs: $failures run(s) differ$tolerance"
 [ "$failures" -eq 0 ]
