@@ -133,13 +133,8 @@ static int from_checkpoint(sp_run *run, const sp_scene *scene, const sp_run_star
  *  exist only there (docs/local-support.md). */
 static int cut_to_supports(sp_run *run) {
   sp_layout *layout = NULL;
-  SP_CALL(sp_support_initial(run->support, run->layout, run->state, &layout));
-  double *state = calloc(2 * (size_t)layout->n_pairs, sizeof(double));
-  if (!state) {
-    sp_layout_destroy(&layout);
-    return sp_error_set(SP_ERR_MEMORY, "out of memory for the local layout");
-  }
-  sp_layout_transfer(run->layout, run->state, layout, state, 0.0);
+  double *state = NULL;
+  SP_CALL(sp_support_initial(run->support, run->layout, run->state, &layout, &state));
   SP_CALL(sp_run_resize(run, layout, state, SP_HISTORY_RESET));
   return sp_run_observe(run, run->cells.obs);
 }

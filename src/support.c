@@ -552,14 +552,31 @@ static int rebuild_widened(sp_support s, const sp_layout *layout, const double *
   return rc;
 }
 
+/** One more layer of elements (++layers[k]) for each cell whose support in
+ *  @p to would call for an update at once with the values @p state;
+ *  *outgrown: whether any would. */
+static int widen_outgrown(sp_support s, const sp_layout *to, const double *state, int *layers,
+                          int *outgrown) {
+  const sp_cell_pairs *cp;
+  SP_CALL(sp_layout_cells(to, &cp));
+  *outgrown = 0;
+  for (int k = 0; k < to->n_cells; ++k)
+    if (cell_needs_update(s, to, cp, state, k)) {
+      ++layers[k];
+      *outgrown = 1;
+    }
+  return SP_OK;
+}
+
 int sp_support_initial(sp_support s, const sp_layout *layout, const double *state,
-                       sp_layout **out) {
+                       sp_layout **out, double **out_state) {
   const int nc = layout->n_cells;
   int *layers;
   SP_ALLOC(layers, nc ? nc : 1);
   double *cut = NULL;
   int rc = SP_OK, outgrown = 1;
   *out = NULL;
+  *out_state = NULL;
   /* as sp_support_rebuild: a support that would call for an update at
    * once (an element wider than margin - band, docs/local-support.md
    * "Coarse meshes") is widened by layers of elements until none would;
@@ -572,18 +589,15 @@ int sp_support_initial(sp_support s, const sp_layout *layout, const double *stat
     if (rc == SP_OK && !(cut = malloc(2 * sizeof(double) * (size_t)(*out)->n_pairs + 1)))
       rc = sp_error_set(SP_ERR_MEMORY, "supports: out of memory");
     if (rc == SP_OK) sp_layout_transfer(layout, state, *out, cut, 0.0);
-    const sp_cell_pairs *cp;
-    if (rc == SP_OK) rc = sp_layout_cells(*out, &cp);
-    outgrown = 0;
-    for (int k = 0; k < nc && rc == SP_OK; ++k)
-      if (cell_needs_update(s, *out, cp, cut, k)) {
-        ++layers[k];
-        outgrown = 1;
-      }
+    if (rc == SP_OK) rc = widen_outgrown(s, *out, cut, layers, &outgrown);
   }
-  free(cut);
   free(layers);
-  if (rc != SP_OK) sp_layout_destroy(out);
+  if (rc != SP_OK) {
+    sp_layout_destroy(out);
+    free(cut);
+    cut = NULL;
+  }
+  *out_state = cut;
   return rc;
 }
 
@@ -609,14 +623,7 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
     free(*new_state);
     rc = rebuild_widened(s, layout, state, may_shrink, layers, new_layout, new_state,
                          mass_correction, mass_dropped);
-    const sp_cell_pairs *cp;
-    if (rc == SP_OK) rc = sp_layout_cells(*new_layout, &cp);
-    outgrown = 0;
-    for (int k = 0; k < nc && rc == SP_OK; ++k)
-      if (cell_needs_update(s, *new_layout, cp, *new_state, k)) {
-        ++layers[k];
-        outgrown = 1;
-      }
+    if (rc == SP_OK) rc = widen_outgrown(s, *new_layout, *new_state, layers, &outgrown);
   }
   free(layers);
   return rc;

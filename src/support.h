@@ -123,9 +123,11 @@ int sp_support_layout(sp_support s, const sp_layout *layout, const double *state
  *        of elements while, with the fields cut to it, it would call for
  *        an update at once (as sp_support_rebuild widens; coarse meshes),
  *        so the first step does not change them again.
+ * @param[out] out_state the fields cut to them ((c, mu) per pair of *out;
+ *             the caller frees it)
  */
 int sp_support_initial(sp_support s, const sp_layout *layout, const double *state,
-                       sp_layout **out);
+                       sp_layout **out, double **out_state);
 
 /** @brief Layout from per-cell masks, with every cell's mask closed to
  *         whole elements (no node without a whole element of its cell). */

@@ -278,9 +278,8 @@ static void coarse_rule(int refinements, double margin, int *computed, int *rebu
   CHECK_OK(sp_support_needs_update(s, rebuilt, next, rebuilt_needs));
   /* the set-up's supports: the computed ones widened, the fields cut */
   sp_layout *initial;
-  CHECK_OK(sp_support_initial(s, full, state, &initial));
-  double *cut = calloc(2 * (size_t)initial->n_pairs, sizeof(double));
-  sp_layout_transfer(full, state, initial, cut, 0.0);
+  double *cut;
+  CHECK_OK(sp_support_initial(s, full, state, &initial, &cut));
   CHECK_OK(sp_support_needs_update(s, initial, cut, initial_needs));
   *n_initial = initial->n_pairs;
   free(cut);
