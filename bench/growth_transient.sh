@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Issue 28's small reproducer: two touching cells growing in the paper's
+# Issue 28's small reproducer (tests/scenes/growth_two.yaml, which
+# tests/growth_steps.sh runs too): two touching cells growing in the paper's
 # ellipse (no division: max_cells 2 only stops the source at 10x), the
 # defaults otherwise (adaptive BDF2 at 1e-2), run with full supports, local
 # supports at the default margin, and local supports at the aggregate's
@@ -25,18 +26,8 @@ bin=${SOFTPACK:-build/softpack}
 out=${OUT:-$(mktemp -d)}
 variants=${VARIANTS:-full local narrow}
 export OMP_NUM_THREADS=1
-scene=$out/growth_two.yaml
+scene=tests/scenes/growth_two.yaml
 mkdir -p "$out"
-cat > "$scene" <<'EOF'
-mesh: {type: ellipse, refinements: 5, semi_x: 0.5, semi_y: 0.25, buffer_layers: 2, buffer_width: 0.1}
-time: {t_end: 0.003}
-source: {rate: 500, off_ratio: 10}
-division: {max_cells: 2}
-cells:
-  - {x: -0.065, y: 0.0, radius: 0.07}
-  - {x: 0.065, y: 0.0, radius: 0.07}
-output: {every: 1000000, pictures: false}
-EOF
 sets_of() {
   case $1 in
     full) echo "--set layout.support=full" ;;
