@@ -161,16 +161,51 @@ def read_vtu_fields(path):
         return None
     with open(path) as f:
         text = f.read()
-
-    def array(data):
-        raw = base64.b64decode("".join(data.split()))
-        n = struct.unpack_from("<Q", raw)[0] // 8
-        return struct.unpack_from(f"<{n}d", raw, 8)
-    c = {name: array(data) for name, data in
-         re.findall(r'<DataArray type="Float64" Name="(c_\d+)" format="binary">\s*([^<]*)<', text)}
-    xyz = array(re.search(r'<DataArray type="Float64" Name="Points" NumberOfComponents="3" '
-                          r'format="binary">\s*([^<]*)<', text).group(1))
+    c = {name: _binary_array(text, name, "d") for name in
+         re.findall(r'<DataArray type="Float64" Name="(c_\d+)" format="binary">', text)}
+    xyz = _binary_array(text, "Points", "d")
     return [xyz[i:i + 3] for i in range(0, len(xyz), 3)], c
+
+
+def read_vtu_elements(path):
+    """The elements of a .vtu softpack wrote, each a tuple of its points'
+    indices (the connectivity cut at the offsets)."""
+    with open(path) as f:
+        text = f.read()
+    connectivity = _binary_array(text, "connectivity", "i")
+    ends = _binary_array(text, "offsets", "q")
+    return [connectivity[a:b] for a, b in zip((0,) + ends[:-1], ends)]
+
+
+def pieces(elements, inside):
+    """The connected pieces of the points in the set @p inside, two points
+    being connected when an element holds both: a list of sets of point
+    indices, the largest first."""
+    parent = {i: i for i in inside}
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+    for element in elements:
+        held = [i for i in element if i in parent]
+        for i in held[1:]:
+            parent[root(i)] = root(held[0])
+    found = defaultdict(set)
+    for i in inside:
+        found[root(i)].add(i)
+    return sorted(found.values(), key=len, reverse=True)
+
+
+def _binary_array(text, name, kind):
+    """The values of the inline binary DataArray @p name (struct format
+    character @p kind: "d", "i", "q")."""
+    data = re.search(rf'<DataArray type="\w+" Name="{name}"[^>]*format="binary">\s*([^<]*)<',
+                     text).group(1)
+    raw = base64.b64decode("".join(data.split()))
+    n = struct.unpack_from("<Q", raw)[0] // struct.calcsize(kind)
+    return struct.unpack_from(f"<{n}{kind}", raw, 8)
 
 
 def _exists(path):
