@@ -24,7 +24,8 @@
 # the arrangement that touching set makes: "diamond" (the embryo's: all
 # pairs but ABa-P2; Giammona and Campas 2021, Fig 1A), "mirror" (all but
 # ABp-P2), "T" (ABa-ABp, ABa-EMS, ABp-EMS, EMS-P2), "linear" (three pairs
-# in a chain), otherwise the pairs themselves; a cell whose c >= 1/2 set
+# in a chain), otherwise the pairs themselves (the diamond table ends with
+# the arrangements as a matrix per shell); a cell whose c >= 1/2 set
 # is in several pieces (connected through the mesh's elements) is named
 # after it ("split"), and its gaps are its largest piece's.
 # usage: bench/embryo_sensitivity.sh [SOFTPACK] [OUT_DIR] [rules|diamond|all]
@@ -143,5 +144,29 @@ if [ "$table" = diamond ] || [ "$table" = all ]; then
           "$(fixed_axis "$b")" "$semi_y, $a, $b"
       done
     done
-  done
+  done | tee "$out/diamond.md"
+  # the same runs' arrangements as one matrix per shell
+  python3 - "$out/diamond.md" <<'EOF'
+import sys
+from collections import defaultdict
+grid = defaultdict(dict)
+for line in open(sys.argv[1]):
+    cols = [c.strip() for c in line.strip().strip("|").split("|")]
+    semi_y, a, b = (v.strip() for v in cols[0].split(","))
+    shape, _, split = cols[-1].partition("; split:")
+    if shape not in ("diamond", "mirror", "T", "linear"):
+        missing = [p for p in ("ABa-ABp", "ABa-EMS", "ABp-EMS", "EMS-P2", "ABa-P2", "ABp-P2")
+                   if p not in shape.split(", ")]
+        shape = "all but " + ", ".join(missing) if missing else "all six"
+    grid[semi_y][(int(a), int(b))] = shape + (" (split)" if split else "")
+for semi_y, cells in grid.items():
+    ab = sorted({a for a, _ in cells})
+    p1 = sorted({b for _, b in cells})
+    print(f"\nshell 50 x {100 * float(semi_y):.0f} um (semi_y {semi_y}): rows AB's normal, "
+          "columns P1's normal (degrees from the egg's axis x)\n")
+    print("| AB \\ P1 | " + " | ".join(str(b) for b in p1) + " |")
+    print("|---|" + "---|" * len(p1))
+    for a in ab:
+        print(f"| {a} | " + " | ".join(cells.get((a, b), "") for b in p1) + " |")
+EOF
 fi
