@@ -10,7 +10,8 @@ units the scene names: um, min) and prints, in Markdown:
     and the first daughter's share of the parent's mass right after the cut;
   - the 4-cell stage (the last step with 4 cells) and the 8-cell stage (the
     last step): each cell's volume (c >= 1/2; an area in 2D) in the scene's
-    unit and as a fraction of the stage's cells, its mass fraction, and the
+    unit and as a fraction of the stage's cells, its mass (in the scene's
+    unit) and the ratio of the two, its mass fraction, and the
     CShaper atlas's volume and fraction (Cao et al. 2020, as quoted in
     issue 30);
   - the contacts of those stages: each pair's contact (contacts.csv) in the
@@ -95,13 +96,17 @@ def main(out):
         total_m = sum(float(r["mass"]) for r in rows)
         total_a = sum(ATLAS[r["name"]] for r in rows)
         print(f"\n{name} stage (step {step}, t = {t:.2f} {tunit}):\n")
-        print(f"| cell | {volume_column} | fraction | mass fraction | atlas um^3 | atlas fraction |")
-        print("|---|---|---|---|---|---|")
+        print(f"| cell | {volume_column} | fraction | mass | {volume_column} / mass "
+              "| mass fraction | atlas um^3 | atlas fraction |")
+        print("|---|---|---|---|---|---|---|---|")
         for r in sorted(rows, key=lambda r: r["name"]):
             v, vunit = conv("cells.csv", volume_column, float(r[volume_column]))
+            m, munit = conv("cells.csv", "mass", float(r["mass"]))
             print(f"| {r['name']} | {v:.1f} {vunit} | {float(r[volume_column]) / total_v:.4f} "
+                  f"| {m:.0f} {munit} | {float(r[volume_column]) / float(r['mass']):.2f} "
                   f"| {float(r['mass']) / total_m:.4f} | {ATLAS[r['name']]} "
                   f"| {ATLAS[r['name']] / total_a:.4f} |")
+        print(f"\n(the {volume_column}s add up to {total_v / total_m:.2f} of the masses)")
         names = {int(r["cell"]): r["name"] for r in rows}
         surface = {int(r["cell"]): float(r["surface"]) for r in contacts[step]
                    if int(r["other"]) == 0}
