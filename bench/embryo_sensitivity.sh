@@ -19,8 +19,9 @@
 # pair's contact as a fraction of the smaller cell's diffuse surface
 # (contacts.csv), and which pairs touch by the gap between their c >= 1/2
 # sets (bench/embryo_table.py's, from the last fields_<step>.vtu): a pair
-# touches when the gap is below GAP_UM (3 um; pressed cells read 1.4 to
-# 1.7 um, a pair with a cell between them its width, 10 um or more), and
+# touches when the gap is below GAP_UM (3 um; pressed cells read 1.1 to
+# 2.9 um, a pair with a cell between them 4.8 um or more, three-cell
+# corners 3.0 to 3.9 um: docs/embryo.md), and
 # the arrangement that touching set makes: "diamond" (the embryo's: all
 # pairs but ABa-P2; Giammona and Campas 2021, Fig 1A), "mirror" (all but
 # ABp-P2), "T" (ABa-ABp, ABa-EMS, ABp-EMS, EMS-P2), "linear" (three pairs
