@@ -10,7 +10,8 @@ units the scene names: um, min) and prints, in Markdown:
     and the first daughter's share of the parent's mass right after the cut;
   - the 4-cell stage (the last step with 4 cells) and the 8-cell stage (the
     last step): each cell's volume (c >= 1/2; an area in 2D) in the scene's
-    unit and as a fraction of the stage's cells, its mass fraction, and the
+    unit and as a fraction of the stage's cells, its mass (in the scene's
+    unit) and the ratio of the two, its mass fraction, and the
     CShaper atlas's volume and fraction (Cao et al. 2020, as quoted in
     issue 30);
   - the contacts of those stages: each pair's contact (contacts.csv) in the
@@ -95,13 +96,17 @@ def main(out):
         total_m = sum(float(r["mass"]) for r in rows)
         total_a = sum(ATLAS[r["name"]] for r in rows)
         print(f"\n{name} stage (step {step}, t = {t:.2f} {tunit}):\n")
-        print(f"| cell | {volume_column} | fraction | mass fraction | atlas um^3 | atlas fraction |")
-        print("|---|---|---|---|---|---|")
+        print(f"| cell | {volume_column} | fraction | mass | {volume_column} / mass "
+              "| mass fraction | atlas um^3 | atlas fraction |")
+        print("|---|---|---|---|---|---|---|---|")
         for r in sorted(rows, key=lambda r: r["name"]):
             v, vunit = conv("cells.csv", volume_column, float(r[volume_column]))
+            m, munit = conv("cells.csv", "mass", float(r["mass"]))
             print(f"| {r['name']} | {v:.1f} {vunit} | {float(r[volume_column]) / total_v:.4f} "
+                  f"| {m:.0f} {munit} | {float(r[volume_column]) / float(r['mass']):.2f} "
                   f"| {float(r['mass']) / total_m:.4f} | {ATLAS[r['name']]} "
                   f"| {ATLAS[r['name']] / total_a:.4f} |")
+        print(f"\n(the {volume_column}s add up to {total_v / total_m:.2f} of the masses)")
         names = {int(r["cell"]): r["name"] for r in rows}
         surface = {int(r["cell"]): float(r["surface"]) for r in contacts[step]
                    if int(r["other"]) == 0}
@@ -161,16 +166,51 @@ def read_vtu_fields(path):
         return None
     with open(path) as f:
         text = f.read()
-
-    def array(data):
-        raw = base64.b64decode("".join(data.split()))
-        n = struct.unpack_from("<Q", raw)[0] // 8
-        return struct.unpack_from(f"<{n}d", raw, 8)
-    c = {name: array(data) for name, data in
-         re.findall(r'<DataArray type="Float64" Name="(c_\d+)" format="binary">\s*([^<]*)<', text)}
-    xyz = array(re.search(r'<DataArray type="Float64" Name="Points" NumberOfComponents="3" '
-                          r'format="binary">\s*([^<]*)<', text).group(1))
+    c = {name: _binary_array(text, name, "d") for name in
+         re.findall(r'<DataArray type="Float64" Name="(c_\d+)" format="binary">', text)}
+    xyz = _binary_array(text, "Points", "d")
     return [xyz[i:i + 3] for i in range(0, len(xyz), 3)], c
+
+
+def read_vtu_elements(path):
+    """The elements of a .vtu softpack wrote, each a tuple of its points'
+    indices (the connectivity cut at the offsets)."""
+    with open(path) as f:
+        text = f.read()
+    connectivity = _binary_array(text, "connectivity", "i")
+    ends = _binary_array(text, "offsets", "q")
+    return [connectivity[a:b] for a, b in zip((0,) + ends[:-1], ends)]
+
+
+def pieces(elements, inside):
+    """The connected pieces of the points in the set @p inside, two points
+    being connected when an element holds both: a list of sets of point
+    indices, the largest first."""
+    parent = {i: i for i in inside}
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+    for element in elements:
+        held = [i for i in element if i in parent]
+        for i in held[1:]:
+            parent[root(i)] = root(held[0])
+    found = defaultdict(set)
+    for i in inside:
+        found[root(i)].add(i)
+    return sorted(found.values(), key=len, reverse=True)
+
+
+def _binary_array(text, name, kind):
+    """The values of the inline binary DataArray @p name (struct format
+    character @p kind: "d", "i", "q")."""
+    data = re.search(rf'<DataArray type="\w+" Name="{name}"[^>]*format="binary">\s*([^<]*)<',
+                     text).group(1)
+    raw = base64.b64decode("".join(data.split()))
+    n = struct.unpack_from("<Q", raw)[0] // struct.calcsize(kind)
+    return struct.unpack_from(f"<{n}{kind}", raw, 8)
 
 
 def _exists(path):
