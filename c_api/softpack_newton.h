@@ -19,7 +19,10 @@ typedef enum {
   SP_NEWTON_DIVERGED,       /**< |F| above solver.newton_divergence x the first */
   SP_NEWTON_NOT_FINITE,     /**< a residual norm was not finite */
   SP_NEWTON_LINEAR_FAILED,  /**< a linear solve failed (reason says how) */
-  SP_NEWTON_OTHER_FAILURE   /**< NOX stopped for another reason */
+  SP_NEWTON_OTHER_FAILURE,  /**< NOX stopped for another reason */
+  SP_NEWTON_INTERRUPTED     /**< sp_step_data.interrupt asked it to stop (a
+                                 stop signal during the step): not a failure
+                                 of the step, which is dropped, not retried */
 } sp_newton_failure;
 
 #endif

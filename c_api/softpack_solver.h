@@ -189,6 +189,11 @@ typedef struct {
    *  small part of the step's (mu is algebraic: it follows c). 0, 0: off,
    *  the residual tolerances alone. */
   double update_rtol, update_atol;
+  /** Polled before each Newton iteration (NULL: never): non-zero stops the
+   *  solve with SP_NEWTON_INTERRUPTED, the state as on entry. Collective:
+   *  every rank must return the same (softpack's agrees over MPI). */
+  int (*interrupt)(void *ctx);
+  void *interrupt_ctx;
 } sp_step_data;
 
 
@@ -253,6 +258,21 @@ int sp_solver_carry_point(sp_solver s, int *carry, double *dt, const double **x,
  *        may begin on it. Collective.
  */
 int sp_solver_carry_restore(sp_solver s, const sp_step_data *data, const double *x);
+
+/**
+ * @brief Remember where the factorisation carried into the next step was
+ *        filled (what sp_solver_carry_point reports now), for
+ *        sp_solver_carry_rewind. Cheap: a copy of the state it was filled at.
+ */
+int sp_solver_carry_mark(sp_solver s);
+
+/**
+ * @brief Report the marked carry point again (a step given up half-way, so
+ *        that a checkpoint written now equals the one written before the
+ *        step: issue 30's stop during a long step). The factorisation itself
+ *        is the given-up attempt's: the next step begins with a new one.
+ */
+int sp_solver_carry_rewind(sp_solver s);
 
 /**
  * @brief One backward-Euler step by Newton. On entry @p state is the initial

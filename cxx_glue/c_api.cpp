@@ -132,6 +132,22 @@ int sp_solver_carry_restore(sp_solver s, const sp_step_data *data, const double 
   });
 }
 
+int sp_solver_carry_mark(sp_solver s) {
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
+  return guarded(s, [&] {
+    need(s->impl != nullptr, "the solver was not created");
+    s->impl->carry_mark();
+  });
+}
+
+int sp_solver_carry_rewind(sp_solver s) {
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
+  return guarded(s, [&] {
+    need(s->impl != nullptr, "the solver was not created");
+    s->impl->carry_rewind();
+  });
+}
+
 int sp_solver_step(sp_solver s, const sp_step_data *data, double *state, sp_step_report *report) {
   if (!s) return SP_SOLVER_ERR_INTERNAL;
   int newton = 0;

@@ -279,6 +279,21 @@ class UpdateSmall : public ConditionTest {
   double rtol_ = 0, atol_ = 0;
 };
 
+// A stop requested during the step (sp_step_data.interrupt, polled at the
+// guess and after each iteration, every rank alike): the solve fails with
+// SP_NEWTON_INTERRUPTED and the caller drops the step.
+class InterruptTest : public ConditionTest {
+ public:
+  explicit InterruptTest(Solver &s)
+      : ConditionTest(NOX::StatusTest::Failed, "No stop requested"), s_(s) {}
+
+ protected:
+  bool holds(const NOX::Solver::Generic &) const override { return s_.interrupt_requested(); }
+
+ private:
+  Solver &s_;
+};
+
 // Modified Newton's iteration limit: this many factorisations (each
 // iteration that reused one was cheap, and followed one that cut ||F|| by
 // jacobian_reuse).
@@ -451,6 +466,7 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
   converged->addStatusTest(tolerance);
   converged->addStatusTest(Teuchos::rcp(new AtLeastOneIteration));
   auto all = Teuchos::rcp(new Combo(Combo::OR));
+  all->addStatusTest(Teuchos::rcp(new InterruptTest(*this)));
   all->addStatusTest(Teuchos::rcp(new FiniteValue));
   all->addStatusTest(converged);
   // Newton: newton_max_its iterations; modified Newton: as many
@@ -649,11 +665,38 @@ void Solver::jacobian_times(const sp_step_data &d, const double *state, bool tra
 
 bool Solver::carry_point(double &dt, const std::vector<double> *&x,
                          const std::vector<sp_shape_coef> *&shape, int &shape_implicit) const {
+  if (rewound_) {  // what it was at carry_mark
+    dt = mark_.dt;
+    x = &mark_.x;
+    shape = &mark_.shape;
+    shape_implicit = mark_.shape_implicit;
+    return mark_.carryable;
+  }
   dt = jac_dt_;
   x = &jac_x_;
   shape = &jac_shape_;
   shape_implicit = jac_shape_implicit_;
   return factor_carryable() && !jac_x_.empty();
+}
+
+void Solver::carry_mark() {
+  const std::vector<double> *x;
+  const std::vector<sp_shape_coef> *shape;
+  double dt;
+  int shape_implicit;
+  const bool carryable = carry_point(dt, x, shape, shape_implicit);
+  if (&mark_.x != x) mark_.x = *x;  // (a second mark after a rewind keeps it)
+  if (&mark_.shape != shape) mark_.shape = *shape;
+  mark_.carryable = carryable;
+  mark_.dt = dt;
+  mark_.shape_implicit = shape_implicit;
+}
+
+void Solver::carry_rewind() { rewound_ = true; }
+
+bool Solver::interrupt_requested() {
+  if (!interrupted_ && interrupt_) interrupted_ = interrupt_(interrupt_ctx_) != 0;
+  return interrupted_;
 }
 
 void Solver::carry_restore(const sp_step_data &d, const double *x) {
@@ -759,6 +802,10 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   // step's shape coefficients); the first iteration's contraction decides.
   carried_ = factor_carryable() && linear_->term().empty();
   last_converged_ = false;
+  rewound_ = false;
+  interrupt_ = d.interrupt;
+  interrupt_ctx_ = d.interrupt_ctx;
+  interrupted_ = false;
   // The guess into the group (every value it held is now invalid), F at the
   // guess, and the step's tolerances into the tests. F(guess) is evaluated
   // here once, as NOX's relative NormF did when it was built per step; the
@@ -807,7 +854,8 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   snprintf(ratio, sizeof ratio, "%g", options_.newton_divergence);
   // (the divergence test's status is this solve's: every test is checked at
   // the guess and after each iteration)
-  report.failure = !linear_failure_.empty() ? SP_NEWTON_LINEAR_FAILED
+  report.failure = interrupted_ ? SP_NEWTON_INTERRUPTED
+                   : !linear_failure_.empty() ? SP_NEWTON_LINEAR_FAILED
                    : !std::isfinite(last) ? SP_NEWTON_NOT_FINITE
                    : !n.diverged.is_null() && n.diverged->getStatus() == Failed
                        ? SP_NEWTON_DIVERGED
@@ -825,6 +873,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
       why = "diverged: |F| above " + std::string(ratio) + " x the first |F| after " + counts;
       break;
     case SP_NEWTON_MAX_ITERATIONS: why = "no convergence in " + counts; break;
+    case SP_NEWTON_INTERRUPTED: why = "a stop was requested during the step"; break;
     default: why = "Newton failed";
   }
   snprintf(report.reason, sizeof report.reason, "%s (last |F| = %.3g)", why.c_str(), last);

@@ -40,6 +40,14 @@ class Solver {
   /// Fill the Jacobian at x with d and factor it: the next step may begin
   /// on it, as in the run whose carry_point this is.
   void carry_restore(const sp_step_data &d, const double *x);
+  /// Remember the carry point carry_point reports now; carry_rewind reports
+  /// it again (a step given up half-way) and makes the next step begin with
+  /// a new Jacobian (the factorisation is the given-up attempt's).
+  void carry_mark();
+  void carry_rewind();
+  /// Whether sp_step_data.interrupt asks the current solve to stop (polled
+  /// by the Newton status tests, newton.cpp's InterruptTest).
+  bool interrupt_requested();
   int ranks() const { return n_ranks_; }
   // Returns 0 when converged, 1 when Newton failed (state untouched).
   int step(const sp_step_data &data, double *state, sp_step_report &report);
@@ -134,6 +142,20 @@ class Solver {
   int jac_shape_implicit_ = 0;
   std::vector<double> jac_x_;
   std::vector<sp_shape_coef> jac_shape_;
+  // carry_mark's copy of what carry_point reports; rewound_: the next step
+  // may not begin on the factorisation (carry_rewind).
+  struct CarryMark {
+    bool carryable = false;
+    double dt = 0;
+    int shape_implicit = 0;
+    std::vector<double> x;
+    std::vector<sp_shape_coef> shape;
+  } mark_;
+  bool rewound_ = false;
+  // The current step's interrupt poll (sp_step_data) and whether it fired.
+  int (*interrupt_)(void *) = nullptr;
+  void *interrupt_ctx_ = nullptr;
+  bool interrupted_ = false;
   // Factor jacobian_matrix_ (solve_linear's first part); false: why says.
   bool factor_jacobian(std::string &why);
   // Factorisations may carry across steps (jacobian_carry, with modified
@@ -141,7 +163,7 @@ class Solver {
   // this layout, and no Jacobian was filled since.
   bool carries() const { return options_.jacobian_reuse > 0 && options_.jacobian_carry > 0; }
   bool factor_carryable() const {
-    return carries() && last_converged_ && !pattern_changed_ && !jacobian_fresh_;
+    return carries() && last_converged_ && !pattern_changed_ && !jacobian_fresh_ && !rewound_;
   }
   std::vector<double> step_norms_;  // ||F|| at the guess and after each iteration
   std::vector<double> full_;     // scratch: the replicated state

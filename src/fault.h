@@ -21,7 +21,12 @@
  *  - attach: where the glue takes a new layout (sp_solver_set_problem,
  *            before its node map's collective: a memory error, likewise).
  * With ":kill" the rank sends itself SIGKILL there instead (not for
- * solver). Anything else in SOFTPACK_FAULT is bad input at set-up.
+ * solver). And SOFTPACK_FAULT=interrupt:RANK:STEP[:ATTEMPT]: rank RANK is
+ * asked to stop (as by SIGTERM) during step STEP, after the first Newton
+ * iteration of the step's attempt ATTEMPT (1 if not given; the first,
+ * then each retry after a rejection), sp_fault_interrupt_due: a stop
+ * during a long step, docs/restart.md.
+ * Anything else in SOFTPACK_FAULT is bad input at set-up.
  * docs/robustness.md, "MPI failures".
  */
 #ifndef SP_FAULT_H
@@ -37,12 +42,17 @@ typedef enum {
   SP_FAULT_STEP = 2,
   SP_FAULT_OUTPUT = 3,
   SP_FAULT_ASSEMBLY = 4,
-  SP_FAULT_ATTACH = 5
+  SP_FAULT_ATTACH = 5,
+  SP_FAULT_INTERRUPT = 6
 } sp_fault_phase;
 
 /** @brief 1 if SOFTPACK_FAULT asks @p rank to fail at @p phase (a ":kill"
  *         fault kills the process here and does not return), else 0. */
 int sp_fault_due(sp_fault_phase phase, int rank);
+
+/** @brief 1 if SOFTPACK_FAULT=interrupt:RANK:STEP[:ATTEMPT] names @p rank,
+ *         @p step and @p attempt (1, 2, ...). */
+int sp_fault_interrupt_due(int rank, int step, int attempt);
 
 /**
  * @brief SP_OK, or the error a fault at @p phase stands for on @p rank

@@ -2,7 +2,6 @@
 #include "monitor.h"
 
 #include <math.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +14,7 @@
 #include "output.h"
 #include "partition.h"
 #include "render.h"
+#include "stop.h"
 #include "run_energy.h"
 #include "wall_clock.h"
 #include "shape.h"
@@ -235,7 +235,8 @@ int sp_monitor_attempt(sp_run *run, const sp_step_attempt *a, int rc) {
   costs->assembly += a->report.t_assembly;
   costs->factorisation += a->report.t_factor;
   costs->solves += a->report.t_solve;
-  if (rc != SP_OK || a->verdict == SP_STEP_ACCEPTED) return rc;
+  if (rc != SP_OK || a->verdict == SP_STEP_ACCEPTED || a->verdict == SP_STEP_INTERRUPTED)
+    return rc;
   SP_CALL(record_attempt(mon, a, run->dtc.dt_next));
   ++sum->failed_attempts;
   costs->failed_factorisations += a->report.factorisations;
@@ -298,12 +299,6 @@ static void count_step(sp_run *run, const sp_step_attempt *a, const sp_step_even
     costs->step = costs->assembly = costs->factorisation = costs->solves = costs->supports = 0;
 }
 
-/** Set by sp_monitor_request_stop (from a signal handler, through
- *  sp_run_request_stop): checkpoint and stop. */
-static atomic_int stop_requested; /* (lock-free: async-signal-safe; set from
-                                     softpack run's signal thread) */
-
-void sp_monitor_request_stop(void) { atomic_store(&stop_requested, 1); }
 
 /** After an accepted step: write a checkpoint if one is due (every
  *  output.checkpoint_every steps, output.checkpoint_seconds since the last)
@@ -313,7 +308,7 @@ static int checkpoint_if_due(sp_run *run, int *signalled) {
   const sp_run_output *o = &run->opt.output;
   sp_monitor *mon = &run->mon;
   /* a signal may reach one rank only, and the clocks differ: agreed */
-  int want_stop = atomic_load(&stop_requested) != 0;
+  int want_stop = sp_stop_requested(); /* (stop.h) */
   int want_time = o->checkpoint_seconds > 0 &&
                   sp_wall_clock() - mon->t_checkpoint >= o->checkpoint_seconds;
   SP_CALL(sp_agree_any(run->agree_comm, &want_stop));
@@ -332,7 +327,7 @@ static int checkpoint_if_due(sp_run *run, int *signalled) {
   mon->t_checkpoint = sp_wall_clock();
   /* a request is forgotten once acted on, not when a run starts: one that
    * came while the scene was read still stops this run */
-  if (want_stop) atomic_store(&stop_requested, 0);
+  if (want_stop) sp_stop_clear();
   /* (the run goes on as if none was written: a run continued from it
    * rebuilds the factorisation this one carries, from /carry) */
   if (want_stop && run->rank == 0) {
@@ -385,6 +380,21 @@ int sp_monitor_step(sp_run *run, const sp_step_attempt *a, const sp_step_events 
     mon->sum->stopped = SP_STOPPED_SIGNAL;
     *stop = 1;
   }
+  return SP_OK;
+}
+
+int sp_monitor_interrupted(sp_run *run, int *stop) {
+  if (run->rank == 0) {
+    if (isatty(fileno(stderr))) fputs("\r\033[K", stderr);
+    fprintf(stderr, "softpack: a stop was requested during step %d: the step is dropped\n",
+            run->step + 1);
+  }
+  run->mon.costs = (sp_step_costs){0};
+  run->mon.step_start = -1;
+  int signalled = 0;
+  SP_CALL(checkpoint_if_due(run, &signalled));
+  run->mon.sum->stopped = SP_STOPPED_SIGNAL;
+  *stop = 1;
   return SP_OK;
 }
 

@@ -42,16 +42,17 @@ int sp_monitor_attempt(sp_run *run, const sp_step_attempt *a, int rc);
  *         a signal asked for one). Collective. */
 int sp_monitor_step(sp_run *run, const sp_step_attempt *a, const sp_step_events *ev, int *stop);
 
+/** @brief After an attempt dropped on a stop request (SP_STEP_INTERRUPTED):
+ *         the message, a checkpoint of the last accepted step (the one a
+ *         stop after that step would have written), *stop = 1. Collective. */
+int sp_monitor_interrupted(sp_run *run, int *stop);
+
 /** @brief At the run's end (whatever its code). */
 void sp_monitor_end(sp_run *run);
 
 /** @brief Free what the monitor holds (not the summary: the caller's). */
 void sp_monitor_free(sp_monitor *mon);
 
-/** @brief Ask for a checkpoint at the end of the step in progress and a
- *  stop (async-signal-safe; run.h's sp_run_request_stop calls it). The
- *  request stands until a run acts on it. */
-void sp_monitor_request_stop(void);
 
 #ifdef __cplusplus
 }

@@ -9,6 +9,7 @@
 #include "monitor.h"
 #include "scene.h"
 #include "stepper.h"
+#include "stop.h"
 
 static int run_loaded(int rc, sp_scene *scene, const sp_run_start *start, const char *out_dir,
                       MPI_Comm comm, sp_step_callback on_step, void *user,
@@ -106,4 +107,4 @@ int sp_run_file_restart(const char *path, int n_set, const char *const *set,
   return rc;
 }
 
-void sp_run_request_stop(void) { sp_monitor_request_stop(); }
+void sp_run_request_stop(void) { sp_stop_request(); }

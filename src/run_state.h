@@ -99,6 +99,13 @@ typedef struct {
   sp_history hist;      /**< the past states (time scheme, error estimate,
                              predictor) on the layout; emptied by a division */
   sp_dt_control dtc;    /**< how dt is chosen: dt_control.h */
+  sp_dt_control dtc_step_start; /**< dtc before the first attempt of the step
+                                     in progress (a step dropped on a stop
+                                     signal goes back to it) */
+  int marked_step;      /**< the step whose start dtc_step_start and the
+                             solver's carry mark hold (-1: none) */
+  int attempt;          /**< attempts of the step in progress so far */
+  int polls;            /**< stop polls in the attempt in progress */
   sp_registry cells;    /**< the cell registry */
   int n_max;            /**< N_max */
   sp_division_params division; /**< the division criterion */

@@ -14,6 +14,7 @@
 #include "shape.h"
 #include "solver_status.h"
 #include "source.h"
+#include "stop.h"
 #include "time_scheme.h"
 #include "wall_clock.h"
 
@@ -85,7 +86,8 @@ static sp_step_data step_data(sp_run *run, sp_scheme_kind kind, double dt) {
   sp_step_data data = {.dt = dt, .model = o->model, .state_old = run->buf.state_old,
                        .source = o->terms.source_rate > 0 ? run->buf.source : NULL,
                        .shape = shape_on(&o->terms) ? run->cells.shape : NULL,
-                       .shape_implicit = o->terms.shape_implicit};
+                       .shape_implicit = o->terms.shape_implicit,
+                       .interrupt = sp_stop_poll, .interrupt_ctx = run};
   if (kind != SP_SCHEME_BE) {
     sp_scheme_be_form(kind, &run->hist, dt, run->buf.state_old, (size_t)run->layout->n_pairs,
                       run->buf.state_eff, &data.dt);
@@ -110,6 +112,17 @@ static int judge(sp_run *run, sp_scheme_kind kind, int solved, sp_step_attempt *
     snprintf(a->why_text, sizeof a->why_text,
              "local error estimate %.3g x the tolerance (time.rtol, time.atol)", a->err);
     a->why = a->why_text;
+  }
+  if (solved != 0 && a->report.failure == SP_NEWTON_INTERRUPTED) {
+    /* dropped: the controller and the carried factorisation as before the
+     * step's first attempt, so a checkpoint now is the one the last step's
+     * end would have written */
+    a->verdict = SP_STEP_INTERRUPTED;
+    run->dtc = run->dtc_step_start;
+    const int rc = sp_solver_carry_rewind(run->solver);
+    return rc == SP_SOLVER_OK
+               ? SP_OK
+               : sp_solver_failed(run->solver, rc, "dropping step %d", run->step + 1);
   }
   if (solved != 0) {
     a->verdict = SP_STEP_NEWTON_FAILED;
@@ -138,6 +151,15 @@ int sp_step_try(sp_run *run, sp_step_attempt *a) {
   *a = (sp_step_attempt){.verdict = SP_STEP_FATAL, .wall_start = sp_wall_clock(), .t = run->t,
                          .err = -1.0};
   const size_t n_pairs = (size_t)run->layout->n_pairs, n_values = 2 * n_pairs;
+  if (run->marked_step != run->step + 1) { /* the step's first attempt */
+    run->dtc_step_start = run->dtc;
+    run->marked_step = run->step + 1;
+    run->attempt = 0;
+    const int rc = sp_solver_carry_mark(run->solver);
+    if (rc != SP_SOLVER_OK) return sp_solver_failed(run->solver, rc, "step %d", run->step + 1);
+  }
+  ++run->attempt;
+  run->polls = 0;
   const double t_event = sp_events_next(run, run->t);
   a->dt = sp_dt_propose(&run->dtc, run->t, t_event, &a->lands);
   a->t_new = a->lands ? t_event : run->t + a->dt;

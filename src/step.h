@@ -33,6 +33,9 @@ typedef enum {
   SP_STEP_ERROR_TOO_LARGE, /**< its error estimate was above the tolerance */
   SP_STEP_LANDING,         /**< a cell's mass passed its division mass inside
                                 it: redo it shorter, landing on the crossing */
+  SP_STEP_INTERRUPTED,     /**< a stop was requested during it: the step is
+                                dropped (the run as before its first attempt,
+                                sp_step_try), the run checkpoints and stops */
   SP_STEP_FATAL            /**< a hard error (sp_step_try's return code) */
 } sp_step_verdict;
 

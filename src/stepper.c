@@ -17,6 +17,7 @@ static int run_steps(sp_run *run) {
     sp_step_attempt a;
     sp_step_events ev;
     rc = sp_monitor_attempt(run, &a, sp_step_try(run, &a));
+    if (rc == SP_OK && a.verdict == SP_STEP_INTERRUPTED) rc = sp_monitor_interrupted(run, &stop);
     if (rc != SP_OK || a.verdict != SP_STEP_ACCEPTED) continue;
     rc = sp_step_complete(run, &a);
     if (rc == SP_OK) rc = sp_events_after_step(run, a.t, &ev);

@@ -7,7 +7,8 @@
 #   processes (exit status 75, also through mpirun; a checkpoint at the
 #   step it stopped) and resumed, write energy.csv,
 #   cells.csv, divisions.csv, contacts.csv and fields.pvd byte for byte as the
-#   uninterrupted run;
+#   uninterrupted run; so does one asked to stop in the middle of a step
+#   (SOFTPACK_FAULT=interrupt:...: the step is dropped, status 75);
 # - SIGKILLs at random times with a checkpoint every step (so some land
 #   inside a checkpoint write): the logs hold whole lines and the newest
 #   checkpoint is readable (the resumed run again equals the whole one);
@@ -127,6 +128,40 @@ ck=$(printf "%s/term/checkpoint_%06d.h5" "$work" "$last")
 grep -q "stopped on a signal after step $last" "$work/term.log" || fail "SIGTERM: no message"
 run "$work/term" --resume "$work/term" || fail "--resume after SIGTERM: status $?"
 same_as_whole "$work/term" "SIGTERM at step $k, resumed"
+
+# A stop requested during a step (SOFTPACK_FAULT=interrupt:RANK:STEP:ATTEMPT:
+# as a SIGTERM landing after the first Newton iteration of that attempt; a
+# 3D step can outlast a scheduler's grace before SIGKILL): the step is
+# dropped, a checkpoint of the step before, status 75, and the resumed run
+# equals the whole one. Once in the first attempt of a random step, once in
+# the second attempt of the first step that was retried, if one was (so the
+# controller's state goes back to the step's start, not only the carried
+# factorisation); on the
+# last process with a launcher (the stop agreed by the others).
+rank=0
+[ ${#launch[@]} -gt 0 ] && rank=1
+retried=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+                   $1 >= 6 && $(c["failed_attempts"]) > 0 { print $1; exit }' "$work/whole/energy.csv")
+specs=("$((6 + RANDOM % (steps / 2 - 6))):1")
+# (the 2D scene retries steps; a scene without a retried step, as the 3D
+# one, has the first case only)
+if [ -n "$retried" ]; then specs+=("$retried:2"); else echo "no retried step: one case"; fi
+for spec in "${specs[@]}"; do
+  k=${spec%%:*}
+  d=$work/interrupt_${spec/:/_}
+  (export SOFTPACK_FAULT="interrupt:$rank:$spec"; run "$d")
+  status=$?
+  last=$(tail -n 1 "$d/energy.csv" | cut -d, -f1)
+  echo "a stop during step $k (attempt ${spec##*:}): status $status, last step $last"
+  [ "$status" -eq 75 ] || fail "interrupt $spec: status $status, expected 75"
+  [ "$last" = $((k - 1)) ] || fail "interrupt $spec: last step $last, expected $((k - 1))"
+  ck=$(printf "%s/checkpoint_%06d.h5" "$d" "$((k - 1))")
+  [ -f "$ck" ] || fail "interrupt $spec: no checkpoint of step $((k - 1)) ($ck)"
+  grep -q "a stop was requested during step $k: the step is dropped" "$d.log" ||
+    fail "interrupt $spec: no message"
+  run "$d" --resume "$d" || fail "--resume after interrupt $spec: status $?"
+  same_as_whole "$d" "a stop during step $k (attempt ${spec##*:}), resumed"
+done
 
 # SIGKILLs at random times, a checkpoint every step: some land in a write
 # (compared with an uninterrupted run with a checkpoint every step too: a
