@@ -17,8 +17,9 @@
  *   distance over the cells at the last step present in both runs
  *   (cells.csv);
  * - l2_err: ||c - c_ref|| / ||c_ref|| over those cells' c at the last
- *   field output (the last file of fields.pvd), nodal with lumped quad
- *   weights.
+ *   field output (the last file of fields.pvd; a .pvtu, written by a run
+ *   on several processes, has its pieces gathered by their node_id), nodal
+ *   with lumped quad weights.
  * Cells are matched by generation and position, not by number: with the
  * mass criterion the cells of one generation divide one at a time, in an
  * order (and so with child numbers) that can differ between runs. A cell
@@ -48,22 +49,24 @@ static csv_table read_csv(const char *dir, const char *name) {
   return t;
 }
 
-/* The last .vtu listed in DIR/fields.pvd, read whole. */
-static char *last_vtu(const char *dir) {
+/* DIR/NAME read whole (dies if it cannot be). */
+static char *slurp_in(const char *dir, const char *name) {
   char path[4096];
-  snprintf(path, sizeof path, "%s/fields.pvd", dir);
-  char *pvd = slurp(path, NULL);
-  if (!pvd) die("cannot read", path);
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  char *text = slurp(path, NULL);
+  if (!text) die("cannot read", path);
+  return text;
+}
+
+/* The name of the last file listed in DIR/fields.pvd (a .vtu, or a .pvtu
+ * with a piece per process), into @p name. */
+static void last_fields(const char *dir, char *name, size_t cap) {
+  char *pvd = slurp_in(dir, "fields.pvd");
   const char *last = NULL;
   for (const char *p = pvd; (p = strstr(p, "file=\"")); ++p) last = p + 6;
-  if (!last) die("no file in", path);
-  char name[1024];
-  snprintf(name, sizeof name, "%.*s", (int)strcspn(last, "\""), last);
+  if (!last) die("no file in", dir);
+  snprintf(name, cap, "%.*s", (int)strcspn(last, "\""), last);
   free(pvd);
-  snprintf(path, sizeof path, "%s/%s", dir, name);
-  char *xml = slurp(path, NULL);
-  if (!xml) die("cannot read", path);
-  return xml;
 }
 
 /* The generation of every cell (divisions since the start) at the end of
@@ -128,39 +131,125 @@ static double *array(const char *xml, const char *name, size_t *n, const char *d
   size_t bytes;
   double *v = (double *)vtu_array_data(xml, name, &bytes);
   if (!v) die("missing array", name);
-  (void)dir;
+  (void)dir; /* (kept for the callers) */
   *n = bytes / sizeof(double);
   return v;
 }
 
-/* pair[j]: the run's cell number matched to the reference's cell number j
+enum { MAX_PIECES = 256 };
+
+/* A run's last field output: its pieces (one for a .vtu; one per process
+ * for a .pvtu), each with its global node numbers (node_id; a .vtu without
+ * them: 0, 1, ...), and the number of global nodes. */
+typedef struct {
+  int n_pieces;
+  char *xml[MAX_PIECES];
+  int32_t *id[MAX_PIECES];
+  size_t n_local[MAX_PIECES], n;
+} fields_out;
+
+static void fields_read(const char *dir, fields_out *f) {
+  char name[1024];
+  last_fields(dir, name, sizeof name);
+  memset(f, 0, sizeof *f);
+  const size_t len = strlen(name);
+  if (len > 5 && strcmp(name + len - 5, ".pvtu") == 0) {
+    char *top = slurp_in(dir, name);
+    const char *key = "<Piece Source=\"";
+    for (const char *p = top; (p = strstr(p, key)); ++p) {
+      if (f->n_pieces == MAX_PIECES) die("too many pieces in", name);
+      p += strlen(key);
+      char piece[1024];
+      snprintf(piece, sizeof piece, "%.*s", (int)strcspn(p, "\""), p);
+      f->xml[f->n_pieces++] = slurp_in(dir, piece);
+    }
+    free(top);
+    if (f->n_pieces == 0) die("no piece in", name);
+  } else {
+    f->xml[f->n_pieces++] = slurp_in(dir, name);
+  }
+  for (int q = 0; q < f->n_pieces; ++q) {
+    size_t n_pts;
+    free(array(f->xml[q], "Points", &n_pts, dir));
+    f->n_local[q] = n_pts / 3;
+    size_t bytes;
+    f->id[q] = (int32_t *)vtu_array_data(f->xml[q], "node_id", &bytes);
+    if (!f->id[q]) {
+      if (f->n_pieces > 1) die("a piece without node_id in", dir);
+      f->id[q] = malloc(f->n_local[q] * sizeof(int32_t));
+      for (size_t i = 0; i < f->n_local[q]; ++i) f->id[q][i] = (int32_t)i;
+    } else if (bytes != f->n_local[q] * sizeof(int32_t)) {
+      die("node_id does not match the points in", dir);
+    }
+    for (size_t i = 0; i < f->n_local[q]; ++i)
+      if ((size_t)f->id[q][i] + 1 > f->n) f->n = (size_t)f->id[q][i] + 1;
+  }
+}
+
+static void fields_free(fields_out *f) {
+  for (int q = 0; q < f->n_pieces; ++q) free(f->xml[q]), free(f->id[q]);
+}
+
+/* Array @p name (components per node: @p nc) on the global nodes. */
+static double *fields_global(const fields_out *f, const char *name, int nc) {
+  double *g = calloc(f->n * nc, sizeof(double));
+  for (int q = 0; q < f->n_pieces; ++q) {
+    size_t n;
+    double *v = array(f->xml[q], name, &n, NULL);
+    if (n != f->n_local[q] * nc) die("an array of another length", name);
+    for (size_t i = 0; i < f->n_local[q]; ++i)
+      for (int c = 0; c < nc; ++c) g[(size_t)f->id[q][i] * nc + c] = v[i * nc + c];
+    free(v);
+  }
+  return g;
+}
+
+/* The nodes' lumped quad weights: a quarter of each element's area (the
+ * pieces' elements are disjoint). */
+static double *fields_weights(const fields_out *f) {
+  double *w = calloc(f->n, sizeof(double));
+  for (int q = 0; q < f->n_pieces; ++q) {
+    size_t n_pts, n_conn_bytes;
+    double *pts = array(f->xml[q], "Points", &n_pts, NULL);
+    int32_t *conn = (int32_t *)vtu_array_data(f->xml[q], "connectivity", &n_conn_bytes);
+    if (!conn) die("missing connectivity", "fields");
+    const size_t n_quads = n_conn_bytes / (4 * sizeof(int32_t));
+    for (size_t e = 0; e < n_quads; ++e) { /* shoelace area, a quarter to each node */
+      double area = 0;
+      for (int i = 0; i < 4; ++i) {
+        const int32_t p = conn[4 * e + i], r = conn[4 * e + (i + 1) % 4];
+        area += pts[3 * p] * pts[3 * r + 1] - pts[3 * r] * pts[3 * p + 1];
+      }
+      for (int i = 0; i < 4; ++i) w[f->id[q][conn[4 * e + i]]] += fabs(area) / 8;
+    }
+    free(pts);
+    free(conn);
+  }
+  return w;
+}
+
+/* ||c - c_ref|| / ||c_ref|| over the matched cells at both runs' last field
+ * output, on the global nodes (a .pvtu's pieces gathered by node_id).
+ * pair[j]: the run's cell number matched to the reference's cell number j
  * (0: none), for j < n_pair. */
 static double l2_error(const char *run, const char *ref, const int *pair, int n_pair) {
-  char *a = last_vtu(run), *b = last_vtu(ref);
-  size_t n_pts, n_conn_bytes, n_b;
-  double *pts = array(b, "Points", &n_pts, ref);
-  int32_t *conn = (int32_t *)vtu_array_data(b, "connectivity", &n_conn_bytes);
-  if (!conn) die("missing connectivity", ref);
-  const size_t n_nodes = n_pts / 3, n_quads = n_conn_bytes / (4 * sizeof(int32_t));
-  double *w = calloc(n_nodes, sizeof(double));
-  for (size_t e = 0; e < n_quads; ++e) { /* shoelace area, a quarter to each node */
-    double area = 0;
-    for (int i = 0; i < 4; ++i) {
-      const int32_t p = conn[4 * e + i], q = conn[4 * e + (i + 1) % 4];
-      area += pts[3 * p] * pts[3 * q + 1] - pts[3 * q] * pts[3 * p + 1];
-    }
-    for (int i = 0; i < 4; ++i) w[conn[4 * e + i]] += fabs(area) / 8;
-  }
+  static fields_out a, b;
+  fields_read(run, &a);
+  fields_read(ref, &b);
+  if (a.n != b.n) die("different meshes", run);
+  double *pa = fields_global(&a, "Points", 3), *pb = fields_global(&b, "Points", 3);
+  if (memcmp(pa, pb, 3 * b.n * sizeof(double)) != 0) die("different meshes", run);
+  free(pa);
+  free(pb);
+  double *w = fields_weights(&b);
   double diff = 0, norm = 0;
   for (int k = 1; k < n_pair; ++k) {
     if (pair[k] == 0) continue;
     char name[32], name_a[32];
     snprintf(name, sizeof name, "c_%d", k);
     snprintf(name_a, sizeof name_a, "c_%d", pair[k]);
-    size_t na;
-    double *ca = array(a, name_a, &na, run), *cb = array(b, name, &n_b, ref);
-    if (na != n_nodes || n_b != n_nodes) die("different meshes", name);
-    for (size_t i = 0; i < n_nodes; ++i) {
+    double *ca = fields_global(&a, name_a, 1), *cb = fields_global(&b, name, 1);
+    for (size_t i = 0; i < b.n; ++i) {
       diff += w[i] * (ca[i] - cb[i]) * (ca[i] - cb[i]);
       norm += w[i] * cb[i] * cb[i];
     }
@@ -168,10 +257,8 @@ static double l2_error(const char *run, const char *ref, const int *pair, int n_
     free(cb);
   }
   free(w);
-  free(pts);
-  free(conn);
-  free(a);
-  free(b);
+  fields_free(&a);
+  fields_free(&b);
   return sqrt(diff / norm);
 }
 

@@ -33,6 +33,8 @@
 # distance from the reference: the reference's own error is about a third
 # of it). Every run logs at multiples of output.interval
 # (INTERVAL, default 0.002; 5e-4 on c16), where the energies are compared.
+# SETS: more --set options of every run, the reference's too (e.g. SETS="--set
+# layout.support=full" on c2, which runs on local supports as the scene does).
 # OUT/NAME.commit records the program (`softpack --version`) each row ran.
 # Rows: name, steps, factorisations (accepted and failed attempts), failed
 # attempts, wall seconds (sum of the per-step seconds), then the errors
@@ -68,10 +70,11 @@ fixed=${FIXED:-"1 2 4 8"}
 interval=${INTERVAL:-$interval}
 [ -n "$energy_at" ] && energy_at=$interval # c: energies at its multiples only (bench_compare_runs)
 read -r -a solver <<< "${SOLVER:-}"
+read -r -a sets <<< "${SETS:-}"
 export OMP_NUM_THREADS=1
 mkdir -p "$out"
 common=(--set output.interval="$interval" --set output.every=100000000
-        --set output.pictures=false "${cut[@]}")
+        --set output.pictures=false "${cut[@]}" "${sets[@]}")
 dt=$(awk '/^time:/ { if (match($0, /dt: *[0-9.eE+-]+/)) { s = substr($0, RSTART, RLENGTH);
        sub(/dt: */, "", s); print s } }' "${pinned:-$scene}")
 dt=${dt:-2e-4}
