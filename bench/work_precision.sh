@@ -9,7 +9,8 @@
 #   bench/work_precision.sh b [OUT]   the paper's run 5, inputs/paper/embryo_8.yaml
 #                                     (1 -> 8 cells, divisions; T = 0.016)
 #   bench/work_precision.sh c2 [OUT]  the paper's run 2, inputs/paper/growth_12.yaml
-#                                     (growth by the mass criterion, full supports),
+#                                     (growth by the mass criterion; local supports,
+#                                     layout.support auto, as the scene runs),
 #                                     cut at T = T_END (default 0.006: 8 cells, after
 #                                     the third generation's staggered divisions)
 #   bench/work_precision.sh c16 [OUT] the aggregate cut at 16 cells (local supports,
@@ -21,18 +22,19 @@
 #
 # Environment: REF_TOL (the reference: adaptive BDF2 at rtol = atol =
 # REF_TOL; default 1e-5 on a), REF_DT (instead: fixed-dt BDF2 at REF_DT;
-# default on b: dt / 128, 16x below the finest fixed step), TOLS_BE, TOLS_BDF2 (tolerance lists), FIXED
+# default on b, c2 and c16: dt / 128, 16x below the finest fixed step), TOLS_BE, TOLS_BDF2 (tolerance lists), FIXED
 # (divisors of dt, default "1 2 4 8"), SOLVER (extra --set options of every
 # run but "today"; default: the program's defaults), SKIP_REF=1 (reuse the
 # reference in OUT), KEEP=1 (keep the runs OUT holds from an interrupted
 # report: a run that finished left OUT/NAME.done; with SKIP_REF=1 KEEP=1 and
-# the adaptive rows' directories removed, only those rows run again),
-# On c2 and c16 the energies are compared at the multiples of the interval
-# only: their other common times can fall between two runs' divisions of a
-# cell. REF_CHECK=1 (also the reference at 2 x its dt, "ref_2dt", and its
-# distance from the reference: the reference's own error is about a third
-# of it). Every run logs at multiples of output.interval
-# (INTERVAL, default 0.002; 5e-4 on c16), where the energies are compared.
+# the adaptive rows' directories and .done files removed, only those rows
+# run again), REF_CHECK=1 (also the reference at 2 x its dt, "ref_2dt", and
+# its distance from the reference: the reference's own error is a third of
+# that distance at second order, about the distance itself at first order).
+# Every run logs at multiples of output.interval (INTERVAL, default 0.002;
+# 5e-4 on c16), where the energies are compared; on c2 and c16 at those
+# multiples only (their other common times can fall between two runs'
+# divisions of a cell).
 # SETS: more --set options of every run, the reference's too (e.g. SETS="--set
 # layout.support=full" on c2, which runs on local supports as the scene does).
 # OUT/NAME.commit records the program (`softpack --version`) each row ran.
