@@ -13,7 +13,6 @@
  *  point (f''(c) = 0 at c = (1 - 1/sqrt 3) / 2): where mu exceeds what
  *  that branch can reach, the equation's other root is a new cell's
  *  interior, which the field beyond the edge does not become in a step. */
-#define SP_FAR_FIELD_SPINODAL 0.21132486540518711775
 
 /** One new pair's row of the far-field equations: sum_b K_ab v_b over the
  *  elements whole for its cell (off-diagonal entries by pair), K_aa,

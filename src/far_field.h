@@ -34,6 +34,11 @@
 extern "C" {
 #endif
 
+/** The largest c the relaxation gives a new pair: the double well's lower
+ *  spinodal, (1 - 1/sqrt(3)) / 2, where f(c) = alpha c^2 (c - 1)^2 turns
+ *  concave (above it a uniform far field is unstable). */
+#define SP_FAR_FIELD_SPINODAL 0.21132486540518711775
+
 /** The model's constants the far field depends on. */
 typedef struct {
   double alpha, kappa, lambda, lambda_b;

@@ -417,7 +417,18 @@ static void continue_far_field(sp_support s, const sp_layout *layout, const doub
 static int relax_new_pairs(sp_support s, const sp_layout *layout, const sp_layout *to,
                            double *next, const double *mu_far) {
   unsigned char *is_new;
+  double *guess; /* the edge rule's values: a cell whose far field has no
+                    stable state keeps them */
   SP_ALLOC(is_new, to->n_pairs);
+  guess = malloc(sizeof(double) * 2 * (size_t)to->n_pairs + 1);
+  unsigned char *unstable = calloc((size_t)to->n_cells + 1, 1);
+  if (!guess || !unstable) {
+    free(is_new);
+    free(guess);
+    free(unstable);
+    return sp_error_set(SP_ERR_MEMORY, "out of memory filling supports");
+  }
+  memcpy(guess, next, sizeof(double) * 2 * (size_t)to->n_pairs);
   for (int i = 0; i < to->n_nodes; ++i)
     for (int q = to->node_start[i]; q < to->node_start[i + 1]; ++q)
       is_new[q] = sp_layout_pair(layout, to->pair_cell[q], i) < 0;
@@ -425,7 +436,22 @@ static int relax_new_pairs(sp_support s, const sp_layout *layout, const sp_layou
                                   .lambda = s->params.lambda, .lambda_b = s->params.lambda_b,
                                   .mu_far = mu_far};
   const int rc = sp_far_field_relax(s->mesh, s->ne_start, s->ne_list, &fp, to, is_new, next, NULL);
+  /* A new pair held at the spinodal: the cell's edge mu has no stable far
+   * field (a small, pressed cell); relaxed values there would nucleate a
+   * second piece or, spread over a large new area, carry many times the
+   * cell's mass, which the interior shift then takes out (run 2 with the
+   * defaults: c -> -2). That cell keeps the edge rule's values. */
+  for (int q = 0; q < to->n_pairs; ++q)
+    if (is_new[q] && next[2 * q] >= SP_FAR_FIELD_SPINODAL * (1 - 1e-12))
+      unstable[to->pair_cell[q]] = 1;
+  for (int q = 0; q < to->n_pairs; ++q)
+    if (is_new[q] && unstable[to->pair_cell[q]]) {
+      next[2 * q] = guess[2 * q];
+      next[2 * q + 1] = guess[2 * q + 1];
+    }
   free(is_new);
+  free(guess);
+  free(unstable);
   return rc;
 }
 

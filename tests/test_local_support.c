@@ -144,7 +144,7 @@ typedef struct {
 static const double rb_cx[2] = {0.40, 0.63}, rb_r[2] = {0.12, 0.10}, rb_c_e = 0.02,
                     rb_mu = 0.1, rb_kappa = 1e-3, rb_alpha = 4, rb_lambda = 100;
 
-static void rebuild_setup(sp_support_fill_kind fill, rebuild_case *rc) {
+static void rebuild_setup(sp_support_fill_kind fill, double mu, rebuild_case *rc) {
   CHECK_OK(sp_mesh_rectangle(0, 0, 1, 0.6, 80, 48, &rc->mesh));
   const int nn = rc->mesh->n_nodes;
   const double d = sqrt(rb_kappa / (2 * rb_alpha));
@@ -156,7 +156,7 @@ static void rebuild_setup(sp_support_fill_kind fill, rebuild_case *rc) {
           hypot(rc->mesh->xy[2 * i] - rb_cx[k], rc->mesh->xy[2 * i + 1] - 0.3) - rb_r[k];
       const double p = 1.0 / (1.0 + exp(dist / d));
       rc->state[2 * sp_layout_pair(rc->full, k, i)] = p + (1 - p) * (k == 0 ? rb_c_e : 0.0);
-      rc->state[2 * sp_layout_pair(rc->full, k, i) + 1] = rb_mu;
+      rc->state[2 * sp_layout_pair(rc->full, k, i) + 1] = mu;
     }
   sp_support_params narrow = {.margin = 3 * d, .core_threshold = 0.1, .grow_threshold = 0.1,
                               .band = 2 * d, .alpha = rb_alpha, .kappa = rb_kappa,
@@ -194,7 +194,7 @@ static void rebuild_free(rebuild_case *rc) {
  * the rebuild uses equal each cell's node weights exactly. */
 static void test_rebuild_growth(void) {
   rebuild_case rc;
-  rebuild_setup(SP_SUPPORT_FILL_EDGE, &rc);
+  rebuild_setup(SP_SUPPORT_FILL_EDGE, rb_mu, &rc);
   const sp_mesh *mesh = rc.mesh;
   const int nn = mesh->n_nodes;
   const double c_e = rb_c_e, alpha = rb_alpha, lambda = rb_lambda;
@@ -282,7 +282,7 @@ static void test_rebuild_growth(void) {
  * inside the neighbour stay below that (held down by the repulsion). */
 static void test_rebuild_relax(void) {
   rebuild_case rc;
-  rebuild_setup(SP_SUPPORT_FILL_RELAX, &rc);
+  rebuild_setup(SP_SUPPORT_FILL_RELAX, rb_mu, &rc);
   const sp_mesh *mesh = rc.mesh;
   const int nn = mesh->n_nodes;
   const double alpha = rb_alpha, mu = rb_mu, d = sqrt(rb_kappa / (2 * rb_alpha));
@@ -326,10 +326,46 @@ static void test_rebuild_relax(void) {
   rebuild_free(&rc);
 }
 
+/* The relaxed fill where the far field has no stable state: with mu = 1
+ * on cell 0's edge (above 2 alpha c (c - 1) (2 c - 1)'s largest value on
+ * the lower branch, 0.77 at the spinodal c = 0.211) the relaxation would
+ * hold every new pair at the spinodal, where a uniform state is unstable
+ * (a second piece of the cell grows there) and which over the new area is
+ * many times the cell's mass. The cell keeps the edge rule's values: the
+ * rebuild equals the edge rule's value for value, its new pairs below the
+ * spinodal, and the masses are kept. */
+static void test_rebuild_relax_unstable(void) {
+  rebuild_case relax, edge;
+  rebuild_setup(SP_SUPPORT_FILL_RELAX, 1.0, &relax);
+  rebuild_setup(SP_SUPPORT_FILL_EDGE, 1.0, &edge);
+  CHECK(relax.grown->n_pairs == edge.grown->n_pairs, "layouts differ: %d vs %d pairs",
+        relax.grown->n_pairs, edge.grown->n_pairs);
+  int n_new = 0;
+  double largest = 0, differ = 0;
+  for (int i = 0; i < relax.mesh->n_nodes; ++i) {
+    const int p = sp_layout_pair(relax.grown, 0, i);
+    if (p < 0 || sp_layout_pair(relax.layout, 0, i) >= 0) continue;
+    ++n_new;
+    largest = fmax(largest, relax.next[2 * p]);
+  }
+  for (int q = 0; q < 2 * relax.grown->n_pairs; ++q)
+    differ = fmax(differ, fabs(relax.next[q] - edge.next[q]));
+  printf("rebuild (relax, mu = 1): %d new pairs, largest c %.4f, largest difference from the "
+         "edge rule %.1e, mass correction %.3e (edge rule %.3e)\n", n_new, largest, differ,
+         relax.correction, edge.correction);
+  CHECK(n_new > 0, "cell 0's support did not grow");
+  CHECK(largest < 0.211, "a new pair at c = %.4f, at or above the spinodal", largest);
+  CHECK(differ == 0, "the fill differs from the edge rule's by %.3e", differ);
+  CHECK(relax.dropped <= 1e-13, "the rebuild dropped %.3e of the mass", relax.dropped);
+  rebuild_free(&relax);
+  rebuild_free(&edge);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   test_rebuild_growth();
   test_rebuild_relax();
+  test_rebuild_relax_unstable();
   /* 1. local = full on a short scene with a wide margin */
   const char *full_set[] = {"layout.support=full"};
   const char *wide_set[] = {"layout.margin=40", "layout.band=10"};
