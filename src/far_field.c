@@ -9,10 +9,6 @@
 /** The sweeps stop when no c changes by more than this (c is O(1)). */
 #define SP_FAR_FIELD_TOL 1e-9
 #define SP_FAR_FIELD_MAX_SWEEPS 200
-/** The far field stays on the well's lower branch, below its inflection
- *  point (f''(c) = 0 at c = (1 - 1/sqrt 3) / 2): where mu exceeds what
- *  that branch can reach, the equation's other root is a new cell's
- *  interior, which the field beyond the edge does not become in a step. */
 
 /** One new pair's row of the far-field equations: sum_b K_ab v_b over the
  *  elements whole for its cell (off-diagonal entries by pair), K_aa,

@@ -36,7 +36,10 @@ extern "C" {
 
 /** The largest c the relaxation gives a new pair: the double well's lower
  *  spinodal, (1 - 1/sqrt(3)) / 2, where f(c) = alpha c^2 (c - 1)^2 turns
- *  concave (above it a uniform far field is unstable). */
+ *  concave (above it a uniform far field is unstable). Where mu exceeds
+ *  what that branch can reach, the equation's other root is a new cell's
+ *  interior, which the field beyond the edge does not become in a step;
+ *  sp_support_fill then keeps the edge rule for that cell. */
 #define SP_FAR_FIELD_SPINODAL 0.21132486540518711775
 
 /** The model's constants the far field depends on. */

@@ -299,6 +299,12 @@ static void count_step(sp_run *run, const sp_step_attempt *a, const sp_step_even
     costs->step = costs->assembly = costs->factorisation = costs->solves = costs->supports = 0;
 }
 
+/** The step in progress is over (accepted or dropped): its costs and its
+ *  first attempt's clock start afresh. */
+static void forget_step(sp_monitor *mon) {
+  mon->costs = (sp_step_costs){0};
+  mon->step_start = -1;
+}
 
 /** After an accepted step: write a checkpoint if one is due (every
  *  output.checkpoint_every steps, output.checkpoint_seconds since the last)
@@ -363,8 +369,7 @@ int sp_monitor_step(sp_run *run, const sp_step_attempt *a, const sp_step_events 
   /* the state is the one the support change left, if there was one */
   const int rc_row = record_energy(run, a->dt, a->report.newton_its, &mon->costs,
                                    ev->have_energy ? &ev->energy : NULL);
-  mon->costs = (sp_step_costs){0};
-  mon->step_start = -1;
+  forget_step(mon);
   SP_CALL(rc_row);
   const int ends = sp_step_run_ends(run);
   if (mon->on_step) SP_CALL(call_back(run, a, failed, ends, stop));
@@ -389,8 +394,7 @@ int sp_monitor_interrupted(sp_run *run, int *stop) {
     fprintf(stderr, "softpack: a stop was requested during step %d: the step is dropped\n",
             run->step + 1);
   }
-  run->mon.costs = (sp_step_costs){0};
-  run->mon.step_start = -1;
+  forget_step(&run->mon);
   int signalled = 0;
   SP_CALL(checkpoint_if_due(run, &signalled));
   run->mon.sum->stopped = SP_STOPPED_SIGNAL;

@@ -53,7 +53,6 @@ void sp_monitor_end(sp_run *run);
 /** @brief Free what the monitor holds (not the summary: the caller's). */
 void sp_monitor_free(sp_monitor *mon);
 
-
 #ifdef __cplusplus
 }
 #endif

@@ -103,7 +103,7 @@ typedef struct {
                                      in progress (a step dropped on a stop
                                      signal goes back to it) */
   int marked_step;      /**< the step whose start dtc_step_start and the
-                             solver's carry mark hold (-1: none) */
+                             solver's carry mark hold (0: none yet) */
   int attempt;          /**< attempts of the step in progress so far */
   int polls;            /**< stop polls in the attempt in progress */
   sp_registry cells;    /**< the cell registry */
