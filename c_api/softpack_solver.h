@@ -61,7 +61,8 @@ enum {
   SP_SOLVER_MUMPS = 2,
   SP_SOLVER_KLU2 = 3,
   SP_SOLVER_GMRES_ILU = 4,
-  SP_SOLVER_KLU = 5
+  SP_SOLVER_KLU = 5,
+  SP_SOLVER_GMRES_CELLS = 6 /**< GMRES on the cells' diagonal blocks (MUMPS) */
 };
 /** SuperLU_DIST's fill-reducing column order: METIS on the graph of the
  *  (cell, node) pairs (c and mu of a pair together), or on the unknowns

@@ -62,6 +62,7 @@ int sp_solver_linear_backend(int linear, const char **backend) {
         available = sp::amesos2_klu2_available();
         break;
       case SP_SOLVER_GMRES_ILU: what = sp::krylov_version(); break;
+      case SP_SOLVER_GMRES_CELLS: what = sp::cell_blocks_version(); break;
       default: return -1;
     }
   } catch (...) {

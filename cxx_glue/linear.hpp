@@ -67,6 +67,9 @@ class DirectSolver {
   // call, and the caller may hand it storage it keeps using: Solver gives
   // the Jacobian's own arrays on one process).
   virtual bool overwrites_values() const { return false; }
+  // The cell of each of the n_global rows (a new layout): for solvers that
+  // work on the cells' blocks; the others ignore it.
+  virtual void set_blocks(const int *, int) {}
 };
 
 // Serial SuperLU (dgstrf/dgstrs on the transposed CSC view of the CSR); one
@@ -101,6 +104,10 @@ struct KrylovOptions {
   double tolerance = 0;
 };
 std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options);
+// GMRES (Belos) preconditioned by the Jacobian's cell-diagonal blocks (the
+// entries coupling two cells dropped), factored by MUMPS (linear_cells.cpp);
+// needs set_blocks. options.fill is not used.
+std::unique_ptr<DirectSolver> make_cell_blocks(MPI_Comm comm, const KrylovOptions &options);
 // Kokkos initialised once per process (Amesos2's and Tpetra's arrays are
 // Kokkos views), finalised at exit if this started it (linear_krylov.cpp).
 void ensure_kokkos();
@@ -117,6 +124,7 @@ const char *klu_version();
 const char *amesos2_klu2_version();
 bool amesos2_klu2_available();
 const char *krylov_version();
+const char *cell_blocks_version();
 
 }  // namespace sp
 #endif

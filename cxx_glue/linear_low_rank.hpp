@@ -62,6 +62,9 @@ class LowRankSolver final : public DirectSolver {
   long iterations() const override { return sparse_->iterations(); }
   int symbolic_count() const override { return sparse_->symbolic_count(); }
   bool overwrites_values() const override { return sparse_->overwrites_values(); }
+  void set_blocks(const int *block_of_row, int n_global) override {
+    sparse_->set_blocks(block_of_row, n_global);
+  }
 
  private:
   // Z = A^-1 U and K's LU from the block solve [B, U] (X gets A^-1 B).

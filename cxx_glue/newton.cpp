@@ -421,6 +421,15 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       direct = make_krylov(comm, k);
       break;
     }
+    case SP_SOLVER_GMRES_CELLS: {
+      KrylovOptions k;
+      k.tolerance = options.krylov_tol;
+      if (!(k.tolerance > 0 && k.tolerance < 1))
+        throw input_error("solver.krylov_tol: expected 0 < tol < 1, got " +
+                          std::to_string(k.tolerance));
+      direct = make_cell_blocks(comm, k);
+      break;
+    }
     default: throw input_error("solver.linear: unknown kind");
   }
   linear_ = std::make_unique<LowRankSolver>(comm, std::move(direct));
@@ -532,6 +541,12 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   first_row_ = 0;  // (also right for a rank without rows)
   for (int r = 0; r < rank_; ++r) first_row_ += counts[r];
   n_global_ = (int)g.getGlobalNumRows();
+  {  // the cell of every row, for the solvers on the cells' blocks
+    std::vector<int> cell_of_row((size_t)n_global_);
+    for (int p = 0; p < n_global_ / 2; ++p)
+      cell_of_row[2 * (size_t)p] = cell_of_row[2 * (size_t)p + 1] = assembly_->pair_cell(p);
+    linear_->set_blocks(cell_of_row.data(), n_global_);
+  }
   // On one process the column map is the row map (Assembly) and each row
   // is sorted by local column, so the local arrays are the sorted rows
   // already: a backend that only reads them reads the Jacobian's own

@@ -18,7 +18,8 @@ _Static_assert((int)SP_LINEAR_SUPERLU == (int)SP_SOLVER_SUPERLU &&
                (int)SP_LINEAR_MUMPS == (int)SP_SOLVER_MUMPS &&
                (int)SP_LINEAR_KLU2 == (int)SP_SOLVER_KLU2 &&
                (int)SP_LINEAR_GMRES_ILU == (int)SP_SOLVER_GMRES_ILU &&
-               (int)SP_LINEAR_KLU == (int)SP_SOLVER_KLU,
+               (int)SP_LINEAR_KLU == (int)SP_SOLVER_KLU &&
+               (int)SP_LINEAR_GMRES_CELLS == (int)SP_SOLVER_GMRES_CELLS,
                "scene and glue number the linear solvers alike");
 
 const char *sp_version(void) { return SP_VERSION; }

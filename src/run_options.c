@@ -27,7 +27,7 @@ void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt)
   static const int jacobian[] = {SP_SOLVER_JAC_AD, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD};
   static const int linear[] = {SP_SOLVER_SUPERLU, SP_SOLVER_SUPERLU_DIST,
                                SP_SOLVER_MUMPS, SP_SOLVER_KLU2, SP_SOLVER_GMRES_ILU,
-                               SP_SOLVER_KLU};
+                               SP_SOLVER_KLU, SP_SOLVER_GMRES_CELLS};
   opt->jacobian = jacobian[scene->solver.jacobian];
   opt->linear = linear[scene->solver.linear];
   opt->newton_rtol = scene->solver.newton_rtol;

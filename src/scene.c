@@ -172,7 +172,8 @@ static const cyaml_strval_t sp_linear_words[] = {
     {"mumps", SP_LINEAR_MUMPS},
     {"klu", SP_LINEAR_KLU},
     {"klu2", SP_LINEAR_KLU2},
-    {"gmres_ilu", SP_LINEAR_GMRES_ILU}};
+    {"gmres_ilu", SP_LINEAR_GMRES_ILU},
+    {"gmres_cells", SP_LINEAR_GMRES_CELLS}};
 static const cyaml_strval_t sp_ordering_words[] = {
     {"pairs", SP_ORDER_PAIRS}, {"unknowns", SP_ORDER_UNKNOWNS}};
 static const cyaml_strval_t sp_control_words[] = {
@@ -396,7 +397,10 @@ static const sp_key sp_keys[] = {
              "superlu_dist, mumps, klu: SuiteSparse's KLU, klu2: Amesos2's "
              "KLU2, one process only: Debian's is wrong on several, "
              "docs/building.md) or GMRES with an ILU(k) preconditioner "
-             "(gmres_ilu: Belos GMRES, Ifpack2 RILUK, one ILU per process)"),
+             "(gmres_ilu: Belos GMRES, Ifpack2 RILUK, one ILU per process) "
+             "or with the Jacobian's cell-diagonal blocks factored by MUMPS "
+             "(gmres_cells: no fill between cells; the 3D runs' solver, "
+             "docs/3d.md)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
               ABOVE(0.0), BELOW(1.0), "-",
               "Newton: residual reduction relative to the first residual (with "
@@ -448,7 +452,7 @@ static const sp_key sp_keys[] = {
             "cheapest that converges well)"),
     KEY_FLOAT(SP_SEC_SOLVER, "krylov_tol", solver.krylov_tol, 1e-10, ABOVE(0.0), AT_MOST(1e-3),
               "-",
-              "gmres_ilu: a linear solve ends when its residual is below this "
+              "gmres_ilu, gmres_cells: a linear solve ends when its residual is below this "
               "fraction of the right-hand side's norm (a solve not there in "
               "500 iterations fails the Newton attempt)"),
     KEY_ENUM(SP_SEC_SOLVER, "predictor", solver.predictor, SP_PREDICT_LINEAR,

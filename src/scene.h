@@ -40,7 +40,8 @@ typedef enum {
   SP_LINEAR_KLU2 = 3, /**< KLU2 through Amesos2 */
   SP_LINEAR_GMRES_ILU = 4,
   SP_LINEAR_KLU = 5, /**< Amesos (v1)'s KLU */
-  SP_LINEAR_LAST = SP_LINEAR_KLU /**< the kinds are 0 .. SP_LINEAR_LAST */
+  SP_LINEAR_GMRES_CELLS = 6, /**< GMRES, the cells' blocks by MUMPS */
+  SP_LINEAR_LAST = SP_LINEAR_GMRES_CELLS /**< the kinds are 0 .. SP_LINEAR_LAST */
 } sp_linear_kind;
 
 /** mesh: the domain and its discretisation. */

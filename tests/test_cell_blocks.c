@@ -1,0 +1,121 @@
+/* solver.linear = gmres_cells: GMRES preconditioned by the Jacobian's
+ * cell-diagonal part (the entries coupling two cells dropped), factored by
+ * MUMPS. On three touching cells (paper parameters, 3 steps of dt = 1e-4)
+ * it takes the same Newton iterations as serial SuperLU and the states
+ * agree to 1e-9 of the largest value; the cells couple, so the
+ * preconditioner is not A and GMRES needs more than one iteration per
+ * Newton iteration. With one cell the cell-diagonal part is the whole
+ * Jacobian: GMRES then converges in one iteration per solve (were the
+ * filter to drop a cell's own entries it could not). A tolerance GMRES
+ * cannot reach fails the step and leaves the state; a bad tolerance is
+ * refused naming solver.krylov_tol. */
+#include <string.h>
+
+#include "fixtures.h"
+
+enum { N_STEPS = 3 };
+
+/* N_STEPS steps of both solvers from the same state: Newton iterations
+ * equal, states to 1e-9; returns the GMRES and Newton iterations. */
+static void compare_with_superlu(const sp_mesh *mesh, const sp_layout *layout,
+                                 const double *start, const char *what, long *gmres_its,
+                                 long *newton_its) {
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_GMRES_CELLS);
+  opt.krylov_tol = 1e-10; /* the scene's default */
+  sp_solver solvers[2] = {make_solver_opts(mesh, layout, &opt),
+                          make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU)};
+  const int n = 2 * layout->n_pairs;
+  double *x[2], *old = malloc(sizeof(double) * n);
+  for (int s = 0; s < 2; ++s) {
+    x[s] = malloc(sizeof(double) * n);
+    memcpy(x[s], start, sizeof(double) * n);
+  }
+  sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
+  *gmres_its = *newton_its = 0;
+  for (int step = 0; step < N_STEPS; ++step) {
+    sp_step_report rep[2];
+    for (int s = 0; s < 2; ++s) {
+      memcpy(old, x[s], sizeof(double) * n);
+      CHECK(sp_solver_step(solvers[s], &data, x[s], &rep[s]) == 0, "%s, step %d: %s", what, step,
+            rep[s].reason);
+    }
+    double scale = 0, diff = 0;
+    for (int i = 0; i < n; ++i) {
+      scale = fmax(scale, fabs(x[1][i]));
+      diff = fmax(diff, fabs(x[0][i] - x[1][i]));
+    }
+    printf("%s, step %d: Newton iterations %d / %d (cells' blocks / SuperLU), GMRES %ld; "
+           "states differ by %.2e (of %.3g)\n",
+           what, step, rep[0].newton_its, rep[1].newton_its, rep[0].linear_its, diff, scale);
+    CHECK(rep[0].newton_its == rep[1].newton_its, "%s, step %d: Newton iterations %d against %d",
+          what, step, rep[0].newton_its, rep[1].newton_its);
+    CHECK(rep[1].linear_its == 0, "SuperLU reports %ld GMRES iterations", rep[1].linear_its);
+    CHECK(diff <= 1e-9 * scale, "%s, step %d: states differ by %.3e", what, step, diff);
+    *gmres_its += rep[0].linear_its;
+    *newton_its += rep[0].newton_its;
+  }
+  for (int s = 0; s < 2; ++s) {
+    sp_solver_destroy(&solvers[s]);
+    free(x[s]);
+  }
+  free(old);
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  const double d = sqrt(1e-3 / 8);
+  long gmres, newton;
+
+  /* three touching cells: coupled, so more than one GMRES iteration a solve */
+  sp_mesh *mesh;
+  sp_layout *layout;
+  three_cell_problem(&mesh, &layout);
+  int n = 2 * layout->n_pairs;
+  double *x = calloc(n, sizeof(double));
+  set_three_touching_disks(mesh, layout, x);
+  compare_with_superlu(mesh, layout, x, "three cells", &gmres, &newton);
+  CHECK(gmres > newton, "three cells: %ld GMRES iterations for %ld Newton iterations", gmres,
+        newton);
+
+  /* an unreachable tolerance: the step fails, the state stays */
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_GMRES_CELLS);
+  opt.krylov_tol = 1e-30;
+  sp_solver strict = make_solver_opts(mesh, layout, &opt);
+  double *y = malloc(sizeof(double) * n), *old = malloc(sizeof(double) * n);
+  memcpy(y, x, sizeof(double) * n);
+  memcpy(old, x, sizeof(double) * n);
+  sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
+  sp_step_report rep;
+  CHECK(sp_solver_step(strict, &data, y, &rep) == 1, "a step with krylov_tol 1e-30 succeeded");
+  printf("krylov_tol 1e-30: %s\n", rep.reason);
+  CHECK(rep.converged == 0 && rep.newton_its == 0 && rep.linear_its > 0 &&
+            strstr(rep.reason, "GMRES") != NULL,
+        "reason: %s; %d Newton iterations, %ld GMRES iterations", rep.reason, rep.newton_its,
+        rep.linear_its);
+  CHECK(memcmp(y, x, sizeof(double) * n) == 0, "the failed step changed the state");
+  sp_solver_destroy(&strict);
+  free(y);
+  free(old);
+  free(x);
+  sp_layout_destroy(&layout);
+
+  /* one cell: the preconditioner is the Jacobian itself */
+  CHECK_OK(sp_layout_create_full(mesh->n_nodes, 1, &layout));
+  n = 2 * layout->n_pairs;
+  x = calloc(n, sizeof(double));
+  set_disk(mesh, layout, x, 0, 0.45, 0.5, 0.2, d);
+  compare_with_superlu(mesh, layout, x, "one cell", &gmres, &newton);
+  CHECK(gmres == newton, "one cell: %ld GMRES iterations for %ld Newton iterations (want one each)",
+        gmres, newton);
+  free(x);
+  sp_layout_destroy(&layout);
+
+  const double bad[] = {1.5, -1e-8, 0};
+  for (size_t b = 0; b < sizeof bad / sizeof bad[0]; ++b) {
+    opt.krylov_tol = bad[b];
+    expect_solver_refused(&opt, "solver.krylov_tol");
+  }
+  sp_mesh_destroy(&mesh);
+  MPI_Finalize();
+  TEST_DONE();
+}
