@@ -4,7 +4,8 @@
 # (mesh.refinements r; cells 1: the scene's zygote, 8: eight spheres of
 # radius 0.09 at (+-0.11, +-0.095, +-0.095), the scene's cells replaced
 # through bench/lib.sh's scene_without_cells), with each linear solver
-# (superlu_dist on NP_DIST processes), one run at a time. Each run has a
+# (superlu_dist on NP_DIST processes; a solver written NAME@P runs on P
+# processes, e.g. gmres_cells@2), one run at a time. Each run has a
 # memory cap, MEM_GB of address space per process (ulimit -v), and a time
 # cap, TIME_S seconds of CPU per process (ulimit -t: on a shared machine
 # the wall time measures the load as much as the solver), with WALL_S
@@ -25,7 +26,8 @@
 # solver and cell count.
 #   nice -n 10 bench/solvers_3d.sh [CASE ...]
 # Defaults: cases 3:1 3:8 4:1 4:8; STEPS=2, MEM_GB=8, TIME_S=300,
-# WALL_S=3 x TIME_S, SOLVERS="superlu mumps klu superlu_dist gmres_ilu",
+# WALL_S=3 x TIME_S,
+# SOLVERS="superlu mumps klu superlu_dist gmres_ilu gmres_cells",
 # NP_DIST=2; SOFTPACK=path runs another binary; OUT=dir keeps the runs
 # (otherwise a temporary directory, removed at the end). docs/3d.md,
 # "Direct solvers in 3D: where they stop", has a table and what it says.
@@ -37,7 +39,7 @@ cases=("$@")
 [ ${#cases[@]} -eq 0 ] && cases=(3:1 3:8 4:1 4:8)
 steps=${STEPS:-2} mem_gb=${MEM_GB:-8} time_s=${TIME_S:-300} np_dist=${NP_DIST:-2}
 wall_s=${WALL_S:-$((3 * time_s))}
-read -ra solvers <<< "${SOLVERS:-superlu mumps klu superlu_dist gmres_ilu}"
+read -ra solvers <<< "${SOLVERS:-superlu mumps klu superlu_dist gmres_ilu gmres_cells}"
 bin=${SOFTPACK:-build/softpack}
 out=${OUT:-$(mktemp -d)}
 mkdir -p "$out"
@@ -70,14 +72,17 @@ for case in "${cases[@]}"; do
       echo "$run: skipped (stopped at ${stopped[$s]})"
       continue
     fi
+    linear=${s%@*} np=1
+    [ "$linear" = superlu_dist ] && np=$np_dist
+    [ "$s" != "$linear" ] && np=${s#*@} && run=r${r}_c${n}_${linear}_np$np
     launch=()
-    [ "$s" = superlu_dist ] && launch=(mpirun --allow-run-as-root --oversubscribe -np "$np_dist")
+    [ "$np" -gt 1 ] && launch=(mpirun --allow-run-as-root --oversubscribe -np "$np")
     rm -f "$out/$run.time"
     (
       ulimit -v $((mem_gb * 1024 * 1024)) -t "$time_s" -c 0 # (SIGKILL at the CPU cap)
       exec timeout -k 10 "$wall_s" "${launch[@]}" /usr/bin/time -a -o "$out/$run.time" \
         -f "%e %U %S %M" "$bin" run "$file" --out "$out/$run" \
-        --set mesh.refinements="$r" --set time.max_steps="$steps" --set solver.linear="$s" \
+        --set mesh.refinements="$r" --set time.max_steps="$steps" --set solver.linear="$linear" \
         --set output.pictures=false
     ) > "$out/$run.log" 2>&1
     status=$?

@@ -14,6 +14,16 @@
 // x0 = 0, the test |b - A x| <= tolerance |b|, as linear_krylov.cpp's.
 // The filter (which entries of A stay) is built once per pattern; each
 // factor() copies the values through it.
+//
+// Each cell's mass at any GMRES tolerance: a cell's c rows involve its own
+// c and mu only (the mass matrix and the no-flux stiffness), so they are
+// the same in A and in the preconditioner P, and the c rows of B = A P^-1
+// are the identity's. Every Krylov vector b, (B - I) b, (B - I)^2 b, ...
+// past the first has zero c part, so GMRES's residual is r_c = (1 - beta)
+// b_c for one number beta: what the mass of a cell loses is that fraction
+// of b_c's sum over its rows, which GMRES's least squares drives down with
+// the rest (test_cell_blocks: at a tolerance of 1e-4, and Newton ending on
+// a solve's update, each cell's mass to 1e-14 per step).
 #include <BelosLinearProblem.hpp>
 #include <BelosSolverFactory_Tpetra.hpp>
 #include <BelosTpetraAdapter.hpp>

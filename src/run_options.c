@@ -29,12 +29,23 @@ void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt)
                                SP_SOLVER_MUMPS, SP_SOLVER_KLU2, SP_SOLVER_GMRES_ILU,
                                SP_SOLVER_KLU, SP_SOLVER_GMRES_CELLS};
   opt->jacobian = jacobian[scene->solver.jacobian];
-  opt->linear = linear[scene->solver.linear];
+  /* auto: the cells' blocks in 3D, where a direct LU of the coupled
+   * cells runs out of memory, MUMPS in 2D (docs/3d.md, "GMRES on the
+   * cells' blocks") */
+  opt->linear = scene->solver.linear == SP_LINEAR_AUTO
+                    ? (sp_scene_dim(scene) == 3 ? SP_SOLVER_GMRES_CELLS : SP_SOLVER_MUMPS)
+                    : linear[scene->solver.linear];
   opt->newton_rtol = scene->solver.newton_rtol;
   opt->newton_atol = scene->solver.newton_atol;
   opt->newton_max_its = scene->solver.newton_max_its;
   opt->ilu_fill = scene->solver.ilu_fill;
-  opt->krylov_tol = scene->solver.krylov_tol;
+  /* 0: the solver's own tolerance. GMRES on the cells' blocks keeps each
+   * cell's mass at any tolerance (cxx_glue/linear_cells.cpp), and 1e-4
+   * changes the 3D run 5 by 1e-8 (docs/3d.md); ILU's does not, hence its
+   * 1e-10 */
+  opt->krylov_tol = scene->solver.krylov_tol > 0 ? scene->solver.krylov_tol
+                    : opt->linear == SP_SOLVER_GMRES_CELLS ? 1e-4
+                                                           : 1e-10;
   opt->jacobian_reuse = scene->solver.jacobian_reuse;
   opt->jacobian_carry = scene->solver.jacobian_carry;
   opt->newton_divergence = scene->solver.newton_divergence;

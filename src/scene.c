@@ -173,7 +173,8 @@ static const cyaml_strval_t sp_linear_words[] = {
     {"klu", SP_LINEAR_KLU},
     {"klu2", SP_LINEAR_KLU2},
     {"gmres_ilu", SP_LINEAR_GMRES_ILU},
-    {"gmres_cells", SP_LINEAR_GMRES_CELLS}};
+    {"gmres_cells", SP_LINEAR_GMRES_CELLS},
+    {"auto", SP_LINEAR_AUTO}};
 static const cyaml_strval_t sp_ordering_words[] = {
     {"pairs", SP_ORDER_PAIRS}, {"unknowns", SP_ORDER_UNKNOWNS}};
 static const cyaml_strval_t sp_control_words[] = {
@@ -391,7 +392,7 @@ static const sp_key sp_keys[] = {
              sp_jacobian_words, "-",
              "Newton Jacobian: automatic differentiation, hand-coded or "
              "finite differences"),
-    KEY_ENUM(SP_SEC_SOLVER, "linear", solver.linear, SP_LINEAR_MUMPS,
+    KEY_ENUM(SP_SEC_SOLVER, "linear", solver.linear, SP_LINEAR_AUTO,
              sp_linear_words, "-",
              "linear solver of each Newton step: direct (superlu, "
              "superlu_dist, mumps, klu: SuiteSparse's KLU, klu2: Amesos2's "
@@ -399,8 +400,9 @@ static const sp_key sp_keys[] = {
              "docs/building.md) or GMRES with an ILU(k) preconditioner "
              "(gmres_ilu: Belos GMRES, Ifpack2 RILUK, one ILU per process) "
              "or with the Jacobian's cell-diagonal blocks factored by MUMPS "
-             "(gmres_cells: no fill between cells; the 3D runs' solver, "
-             "docs/3d.md)"),
+             "(gmres_cells: no fill between cells, docs/3d.md); auto: "
+             "gmres_cells on a 3D mesh, mumps on a 2D one (the fastest "
+             "measured in each, docs/3d.md)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
               ABOVE(0.0), BELOW(1.0), "-",
               "Newton: residual reduction relative to the first residual (with "
@@ -450,11 +452,12 @@ static const sp_key sp_keys[] = {
             "gmres_ilu: level of fill of the incomplete LU preconditioner "
             "(ILU(k), 0: no fill; 1 stalls on these matrices, 2 is the "
             "cheapest that converges well)"),
-    KEY_FLOAT(SP_SEC_SOLVER, "krylov_tol", solver.krylov_tol, 1e-10, ABOVE(0.0), AT_MOST(1e-3),
+    KEY_FLOAT(SP_SEC_SOLVER, "krylov_tol", solver.krylov_tol, 0.0, AT_LEAST(0.0), AT_MOST(1e-3),
               "-",
               "gmres_ilu, gmres_cells: a linear solve ends when its residual is below this "
               "fraction of the right-hand side's norm (a solve not there in "
-              "500 iterations fails the Newton attempt)"),
+              "500 iterations fails the Newton attempt); 0: the solver's "
+              "own, 1e-10 for gmres_ilu, 1e-4 for gmres_cells (docs/3d.md)"),
     KEY_ENUM(SP_SEC_SOLVER, "predictor", solver.predictor, SP_PREDICT_LINEAR,
              sp_predictor_words, "-",
              "Newton's initial guess: the last state (none) or the last state "

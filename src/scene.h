@@ -41,7 +41,10 @@ typedef enum {
   SP_LINEAR_GMRES_ILU = 4,
   SP_LINEAR_KLU = 5, /**< Amesos (v1)'s KLU */
   SP_LINEAR_GMRES_CELLS = 6, /**< GMRES, the cells' blocks by MUMPS */
-  SP_LINEAR_LAST = SP_LINEAR_GMRES_CELLS /**< the kinds are 0 .. SP_LINEAR_LAST */
+  SP_LINEAR_LAST = SP_LINEAR_GMRES_CELLS, /**< the kinds are 0 .. SP_LINEAR_LAST */
+  /** the default: gmres_cells on a 3D mesh, mumps on a 2D one
+   *  (sp_solver_options_from_scene resolves it) */
+  SP_LINEAR_AUTO = SP_LINEAR_LAST + 1
 } sp_linear_kind;
 
 /** mesh: the domain and its discretisation. */

@@ -23,6 +23,7 @@
 
 #include "check.h"
 #include "error.h"
+#include "run_options.h"
 #include "scene.h"
 
 #ifndef SP_SOURCE_DIR
@@ -96,7 +97,8 @@ static void test_defaults(void) {
   CHECK_NEAR(s->noise.amplitude, 0.0, 0.0);
   CHECK(s->noise.seed == 1u, "seed %u", s->noise.seed);
   CHECK(s->solver.jacobian == SP_JAC_AD, "jacobian %d", s->solver.jacobian);
-  CHECK(s->solver.linear == SP_LINEAR_MUMPS, "linear %d", s->solver.linear);
+  CHECK(s->solver.linear == SP_LINEAR_AUTO, "linear %d", s->solver.linear);
+  CHECK_NEAR(s->solver.krylov_tol, 0.0, 0.0);
   CHECK(s->solver.predictor == SP_PREDICT_LINEAR, "predictor %d", s->solver.predictor);
   CHECK_NEAR(s->solver.jacobian_reuse, 0.1, 0.0);
   CHECK_NEAR(s->solver.jacobian_carry, 0.35, 0.0);
@@ -183,6 +185,41 @@ static void test_every_key(void) {
   }
   CHECK_NEAR(sp_scene_interface_width(s), sqrt(2e-3 / 4.0), 1e-15);
   sp_scene_destroy(&s);
+}
+
+/* solver.linear auto: mumps on a 2D mesh, gmres_cells on a 3D one;
+ * krylov_tol 0: 1e-10 for gmres_ilu, 1e-4 for gmres_cells, else as given */
+static void test_linear_auto(void) {
+  const struct {
+    const char *scene, *set[2];
+    int linear;
+    double tol;
+  } cases[] = {
+      {"tests/scenes/ellipse_minimal.yaml", {NULL, NULL}, SP_SOLVER_MUMPS, 1e-10},
+      {"tests/scenes/ellipse_minimal.yaml", {"solver.linear=gmres_ilu", NULL},
+       SP_SOLVER_GMRES_ILU, 1e-10},
+      {"tests/scenes/ellipse_minimal.yaml", {"solver.linear=gmres_cells", NULL},
+       SP_SOLVER_GMRES_CELLS, 1e-4},
+      {"tests/scenes/restart_3d.yaml", {NULL, NULL}, SP_SOLVER_GMRES_CELLS, 1e-4},
+      {"tests/scenes/restart_3d.yaml", {"solver.krylov_tol=1e-6", NULL}, SP_SOLVER_GMRES_CELLS,
+       1e-6},
+      {"tests/scenes/divide_3d.yaml", {"solver.linear=auto", "solver.krylov_tol=1e-6"},
+       SP_SOLVER_GMRES_CELLS, 1e-6},
+      {"tests/scenes/divide_3d.yaml", {"solver.linear=mumps", NULL}, SP_SOLVER_MUMPS, 1e-10},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    char path[PATH_SIZE];
+    const int n_set = cases[i].set[1] ? 2 : cases[i].set[0] ? 1 : 0;
+    sp_scene *s = NULL;
+    CHECK_OK(sp_scene_load(source_path(cases[i].scene, path), n_set, cases[i].set, &s));
+    sp_solver_options opt;
+    sp_solver_options_from_scene(s, &opt);
+    CHECK(opt.linear == cases[i].linear && opt.krylov_tol == cases[i].tol,
+          "%s %s %s: linear %d (want %d), krylov_tol %g (want %g)", cases[i].scene,
+          cases[i].set[0] ? cases[i].set[0] : "", cases[i].set[1] ? cases[i].set[1] : "",
+          opt.linear, cases[i].linear, opt.krylov_tol, cases[i].tol);
+    sp_scene_destroy(&s);
+  }
 }
 
 static void test_overrides(void) {
@@ -445,6 +482,7 @@ int main(void) {
   test_defaults();
   test_every_key();
   test_overrides();
+  test_linear_auto();
   test_bad_scenes();
   test_files_and_lines();
   test_key_table_documented();
