@@ -24,11 +24,7 @@
 // of b_c's sum over its rows, which GMRES's least squares drives down with
 // the rest (test_cell_blocks: at a tolerance of 1e-4, and Newton ending on
 // a solve's update, each cell's mass to 1e-14 per step).
-#include <BelosLinearProblem.hpp>
-#include <BelosSolverFactory_Tpetra.hpp>
-#include <BelosTpetraAdapter.hpp>
 #include <Teuchos_DefaultMpiComm.hpp>
-#include <Teuchos_ParameterList.hpp>
 #include <Tpetra_Operator.hpp>
 
 #include <cstdio>
@@ -37,6 +33,7 @@
 #include <utility>
 #include <vector>
 
+#include "gmres.hpp"
 #include "linear.hpp"
 #include "tpetra_rows.hpp"
 
@@ -130,34 +127,7 @@ class CellBlockSolver final : public DirectSolver {
       why = "GMRES: solve without a factorisation";
       return false;
     }
-    const int n = rows_->n_local();
-    Belos::ReturnType result;
-    int its = 0;
-    try {
-      {
-        auto rhs = rows_->rhs()->getLocalViewHost(Tpetra::Access::OverwriteAll);
-        for (int i = 0; i < n; ++i) rhs(i, 0) = b[i];
-      }
-      rows_->lhs()->putScalar(0.0);
-      problem_->setProblem();
-      result = gmres_->solve();
-      its = gmres_->getNumIters();
-    } catch (const std::exception &e) {
-      why = std::string("GMRES on the cells' blocks: the solve failed: ") + e.what();
-      return false;
-    }
-    iterations_ += its;
-    if (result != Belos::Converged) {
-      char text[160];
-      std::snprintf(text, sizeof text,
-                    "GMRES on the cells' blocks: no convergence to %g x |b| in %d iterations",
-                    o_.tolerance, its);
-      why = text;
-      return false;
-    }
-    auto lhs = rows_->lhs()->getLocalViewHost(Tpetra::Access::ReadOnly);
-    for (int i = 0; i < n; ++i) x[i] = lhs(i, 0);
-    return true;
+    return gmres_.solve(*rows_, b, x, why, iterations_);
   }
 
   long iterations() const override { return iterations_; }
@@ -167,8 +137,7 @@ class CellBlockSolver final : public DirectSolver {
   // A new pattern: the Tpetra copy of A, the filter to its cell-diagonal
   // part, the GMRES on them.
   void set_up(const CsrRows &A) {
-    gmres_ = Teuchos::null;
-    problem_ = Teuchos::null;
+    gmres_.reset();
     rows_.reset();
     auto rows = std::make_unique<TpetraRows>(comm_, A);
     keep_.clear();
@@ -185,22 +154,7 @@ class CellBlockSolver final : public DirectSolver {
     }
     val_.resize(col_.size());
     prec_ = Teuchos::rcp(new InnerSolveOperator(rows->matrix()->getRowMap(), inner_.get()));
-    auto problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>(
-        rows->matrix(), rows->lhs(), rows->rhs()));
-    problem->setRightPrec(prec_);
-    auto params = Teuchos::rcp(new Teuchos::ParameterList);
-    params->set("Num Blocks", o_.restart);
-    params->set("Maximum Iterations", o_.max_iterations);
-    params->set("Maximum Restarts", o_.max_iterations);
-    params->set("Convergence Tolerance", o_.tolerance);
-    params->set("Implicit Residual Scaling", "Norm of RHS");
-    params->set("Explicit Residual Scaling", "Norm of RHS");
-    params->set("Orthogonalization", "ICGS");
-    params->set("Verbosity", 0);
-    Belos::SolverFactory<double, MV, OP> factory;
-    gmres_ = factory.create("Pseudoblock GMRES", params);
-    gmres_->setProblem(problem);
-    problem_ = problem;
+    gmres_.set_up(*rows, prec_, o_, "GMRES on the cells' blocks");
     rows_ = std::move(rows);
   }
 
@@ -212,8 +166,7 @@ class CellBlockSolver final : public DirectSolver {
   std::vector<int> keep_, ptr_, col_;    // the cell-diagonal part's entries of A
   std::vector<double> val_;
   Teuchos::RCP<OP> prec_;
-  Teuchos::RCP<Belos::LinearProblem<double, MV, OP>> problem_;
-  Teuchos::RCP<Belos::SolverManager<double, MV, OP>> gmres_;
+  Gmres gmres_;
   bool factored_ = false;
   long iterations_ = 0;
 };

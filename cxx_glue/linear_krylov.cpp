@@ -19,9 +19,6 @@
 // factor() writes the values into the matrix's own array through a slot
 // table (one pass, the graph stays), recomputes the ILU's values and keeps
 // its symbolic part.
-#include <BelosLinearProblem.hpp>
-#include <BelosSolverFactory_Tpetra.hpp>
-#include <BelosTpetraAdapter.hpp>
 #include <Ifpack2_Factory.hpp>
 #include <Kokkos_Core.hpp>
 #include <Teuchos_DefaultMpiComm.hpp>
@@ -36,6 +33,7 @@
 #include <utility>
 #include <vector>
 
+#include "gmres.hpp"
 #include "linear.hpp"
 #include "tpetra_rows.hpp"
 
@@ -94,36 +92,7 @@ class KrylovSolver final : public DirectSolver {
       why = "GMRES: solve without a factorisation";
       return false;
     }
-    const int n = rows_->n_local();
-    Belos::ReturnType result;
-    int its = 0;
-    try {
-      {
-        auto rhs = rows_->rhs()->getLocalViewHost(Tpetra::Access::OverwriteAll);
-        for (int i = 0; i < n; ++i) rhs(i, 0) = b[i];
-      }
-      rows_->lhs()->putScalar(0.0);
-      problem_->setProblem();  // the new right-hand side and the initial residual
-      result = gmres_->solve();
-      its = gmres_->getNumIters();
-    } catch (const std::exception &e) {
-      why = std::string("GMRES: the solve failed: ") + e.what();
-      return false;
-    }
-    iterations_ += its;
-    if (result != Belos::Converged) {
-      char text[160];
-      std::snprintf(text, sizeof text,
-                    "GMRES: no convergence to %g x |b| in %d iterations (Belos: %s)", o_.tolerance,
-                    its,
-                    gmres_->isLOADetected() ? "loss of accuracy: the true residual stays above it"
-                                            : "unconverged");
-      why = text;
-      return false;
-    }
-    auto lhs = rows_->lhs()->getLocalViewHost(Tpetra::Access::ReadOnly);
-    for (int i = 0; i < n; ++i) x[i] = lhs(i, 0);
-    return true;
+    return gmres_.solve(*rows_, b, x, why, iterations_);
   }
 
   long iterations() const override { return iterations_; }
@@ -132,8 +101,7 @@ class KrylovSolver final : public DirectSolver {
  private:
   // A new pattern: the Tpetra copy, the ILU's symbolic part, the GMRES.
   bool set_up(const CsrRows &A, std::string &why) {
-    gmres_ = Teuchos::null;
-    problem_ = Teuchos::null;
+    gmres_.reset();
     prec_ = Teuchos::null;
     rows_.reset();
     auto rows = std::make_unique<TpetraRows>(comm_, A);
@@ -166,25 +134,9 @@ class KrylovSolver final : public DirectSolver {
       why = std::string("ILU: symbolic set-up failed: ") + e.what();
       return false;  // rows_ stays empty: the next factor() starts over
     }
-    auto problem = Teuchos::rcp(new Belos::LinearProblem<double, MV, OP>(
-        rows->matrix(), rows->lhs(), rows->rhs()));
-    problem->setRightPrec(prec);
-    auto params = Teuchos::rcp(new Teuchos::ParameterList);
-    params->set("Num Blocks", o_.restart);
-    params->set("Maximum Iterations", o_.max_iterations);
-    // the iteration limit ends the solve, not the restarts
-    params->set("Maximum Restarts", o_.max_iterations);
-    params->set("Convergence Tolerance", o_.tolerance);
-    params->set("Implicit Residual Scaling", "Norm of RHS");
-    params->set("Explicit Residual Scaling", "Norm of RHS");
-    params->set("Orthogonalization", "ICGS");
-    params->set("Verbosity", 0);  // failures are reported through why
-    Belos::SolverFactory<double, MV, OP> factory;
-    gmres_ = factory.create("Pseudoblock GMRES", params);
-    gmres_->setProblem(problem);
+    gmres_.set_up(*rows, prec, o_, "GMRES");
     rows_ = std::move(rows);
     prec_ = prec;
-    problem_ = problem;
     ++symbolic_;
     return true;
   }
@@ -193,8 +145,7 @@ class KrylovSolver final : public DirectSolver {
   KrylovOptions o_;
   std::unique_ptr<TpetraRows> rows_;
   Teuchos::RCP<Prec> prec_;
-  Teuchos::RCP<Belos::LinearProblem<double, MV, OP>> problem_;
-  Teuchos::RCP<Belos::SolverManager<double, MV, OP>> gmres_;
+  Gmres gmres_;
   bool factored_ = false;
   int symbolic_ = 0;
   long iterations_ = 0;
