@@ -4,7 +4,7 @@
 // MUMPS. That matrix is block diagonal, one block (c_k, mu_k) per cell, so
 // its LU has no fill between cells: the 3D 8-cell stage whose coupled LU
 // MUMPS could not allocate (docs/3d.md, "Direct solvers in 3D") factors as
-// eight single-field problems. The cells couple only where their
+// eight one-cell problems. The cells couple only where their
 // interfaces overlap, so GMRES needs few iterations (docs/3d.md, "GMRES on
 // the cells' blocks").
 //
