@@ -34,12 +34,17 @@ void Gmres::set_up(const TpetraRows &rows, const Teuchos::RCP<OP> &prec, const K
 }
 
 void Gmres::reset() {
+  factored_ = false;
   solver_ = Teuchos::null;
   problem_ = Teuchos::null;
 }
 
 bool Gmres::solve(const TpetraRows &rows, const double *b, double *x, std::string &why,
                   long &iterations) {
+  if (!factored_ || solver_.is_null()) {
+    why = name_ + ": solve without a factorisation";
+    return false;
+  }
   const int n = rows.n_local();
   Belos::ReturnType result;
   int its = 0;

@@ -26,8 +26,12 @@ class Gmres {
   void set_up(const TpetraRows &rows, const Teuchos::RCP<OP> &prec, const KrylovOptions &o,
               const char *name);
   void reset();
-  // Solve A x = b (this rank's entries); false with why on no convergence
-  // or a failure. The iterations are added to iterations.
+  // Whether the preconditioner holds the current matrix's factorisation:
+  // false at the start of each factor(), true when it succeeded; solve()
+  // refuses while it is false.
+  void set_factored(bool factored) { factored_ = factored; }
+  // Solve A x = b (this rank's entries); false with why on no convergence,
+  // a failure or no factorisation. The iterations are added to iterations.
   bool solve(const TpetraRows &rows, const double *b, double *x, std::string &why,
              long &iterations);
 
@@ -35,7 +39,8 @@ class Gmres {
   Teuchos::RCP<Belos::LinearProblem<double, TpetraRows::MV, OP>> problem_;
   Teuchos::RCP<Belos::SolverManager<double, TpetraRows::MV, OP>> solver_;
   double tolerance_ = 0;
-  std::string name_;
+  std::string name_ = "GMRES";
+  bool factored_ = false;
 };
 
 }  // namespace sp

@@ -68,7 +68,8 @@ class DirectSolver {
   // the Jacobian's own arrays on one process).
   virtual bool overwrites_values() const { return false; }
   // The cell of each of the n_global rows (a new layout): for solvers that
-  // work on the cells' blocks; the others ignore it.
+  // work on the cells' blocks (uses_blocks()); the others ignore it.
+  virtual bool uses_blocks() const { return false; }
   virtual void set_blocks(const int *, int) {}
 };
 

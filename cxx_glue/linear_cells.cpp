@@ -84,13 +84,14 @@ class CellBlockSolver final : public DirectSolver {
     ensure_kokkos();
   }
 
+  bool uses_blocks() const override { return true; }
   void set_blocks(const int *block_of_row, int n_global) override {
     block_.assign(block_of_row, block_of_row + n_global);
     rows_.reset();  // the filter depends on the blocks: the next factor() starts over
   }
 
   bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
-    factored_ = false;
+    gmres_.set_factored(false);
     if ((int)block_.size() != A.n_global) {
       why = "cell blocks: the rows' cells were not given (set_blocks)";
       return false;
@@ -118,15 +119,11 @@ class CellBlockSolver final : public DirectSolver {
     D.col = col_.data();
     D.val = val_.data();
     if (!inner_->factor(D, !new_pattern, why)) return false;
-    factored_ = true;
+    gmres_.set_factored(true);
     return true;
   }
 
   bool solve(const double *b, double *x, std::string &why) override {
-    if (!factored_) {
-      why = "GMRES: solve without a factorisation";
-      return false;
-    }
     return gmres_.solve(*rows_, b, x, why, iterations_);
   }
 
@@ -167,7 +164,6 @@ class CellBlockSolver final : public DirectSolver {
   std::vector<double> val_;
   Teuchos::RCP<OP> prec_;
   Gmres gmres_;
-  bool factored_ = false;
   long iterations_ = 0;
 };
 

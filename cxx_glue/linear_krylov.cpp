@@ -66,7 +66,7 @@ class KrylovSolver final : public DirectSolver {
   }
 
   bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
-    factored_ = false;
+    gmres_.set_factored(false);
     if (!rows_ || !same_pattern || !rows_->same_pattern(A)) {
       try {
         if (!set_up(A, why)) return false;
@@ -83,15 +83,11 @@ class KrylovSolver final : public DirectSolver {
       why = std::string("ILU: factorisation failed (zero pivot?): ") + e.what();
       return false;
     }
-    factored_ = true;
+    gmres_.set_factored(true);
     return true;
   }
 
   bool solve(const double *b, double *x, std::string &why) override {
-    if (!factored_) {
-      why = "GMRES: solve without a factorisation";
-      return false;
-    }
     return gmres_.solve(*rows_, b, x, why, iterations_);
   }
 
@@ -146,7 +142,6 @@ class KrylovSolver final : public DirectSolver {
   std::unique_ptr<TpetraRows> rows_;
   Teuchos::RCP<Prec> prec_;
   Gmres gmres_;
-  bool factored_ = false;
   int symbolic_ = 0;
   long iterations_ = 0;
 };

@@ -60,6 +60,19 @@ const double *local(const NOX::Abstract::Vector &v) {
   return local(dynamic_cast<const NOX::Thyra::Vector &>(v).getThyraVector());
 }
 
+// The GMRES solvers' options from the scene's: the tolerance as resolved
+// (src/run_options.c turns the scene's 0 into the solver's default).
+KrylovOptions krylov_options(const sp_solver_options &options) {
+  KrylovOptions k;
+  k.tolerance = options.krylov_tol;
+  if (!(k.tolerance > 0 && k.tolerance < 1)) {
+    char got[32];
+    std::snprintf(got, sizeof got, "%g", k.tolerance);
+    throw input_error(std::string("solver.krylov_tol: expected 0 < tol < 1, got ") + got);
+  }
+  return k;
+}
+
 // NOX's model of a step's equations (a Thyra ModelEvaluator): F(x) and
 // the Jacobian at x into the operator NOX passes (JacobianSolve, which
 // stands for Solver's matrix). Built once per layout with the group;
@@ -408,28 +421,15 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
       break;
     case SP_SOLVER_GMRES_ILU: {
       // taken as given: 0 is ILU(0), not a default (the scene has those)
-      KrylovOptions k;
+      if (options.ilu_fill < 0)
+        throw input_error("solver.ilu_fill: expected a fill level >= 0, got " +
+                          std::to_string(options.ilu_fill));
+      KrylovOptions k = krylov_options(options);
       k.fill = options.ilu_fill;
-      k.tolerance = options.krylov_tol;
-      if (k.fill < 0 || !(k.tolerance > 0 && k.tolerance < 1)) {
-        char got[96];
-        std::snprintf(got, sizeof got, "%d and %g", k.fill, k.tolerance);
-        throw input_error(
-            std::string("solver.ilu_fill / krylov_tol: expected fill >= 0 and 0 < tol < 1, got ") +
-            got);
-      }
       direct = make_krylov(comm, k);
       break;
     }
-    case SP_SOLVER_GMRES_CELLS: {
-      KrylovOptions k;
-      k.tolerance = options.krylov_tol;
-      if (!(k.tolerance > 0 && k.tolerance < 1))
-        throw input_error("solver.krylov_tol: expected 0 < tol < 1, got " +
-                          std::to_string(k.tolerance));
-      direct = make_cell_blocks(comm, k);
-      break;
-    }
+    case SP_SOLVER_GMRES_CELLS: direct = make_cell_blocks(comm, krylov_options(options)); break;
     default: throw input_error("solver.linear: unknown kind");
   }
   linear_ = std::make_unique<LowRankSolver>(comm, std::move(direct));
@@ -541,7 +541,7 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   first_row_ = 0;  // (also right for a rank without rows)
   for (int r = 0; r < rank_; ++r) first_row_ += counts[r];
   n_global_ = (int)g.getGlobalNumRows();
-  {  // the cell of every row, for the solvers on the cells' blocks
+  if (linear_->uses_blocks()) {  // the cell of every row, for the solvers on the cells' blocks
     std::vector<int> cell_of_row((size_t)n_global_);
     for (int p = 0; p < n_global_ / 2; ++p)
       cell_of_row[2 * (size_t)p] = cell_of_row[2 * (size_t)p + 1] = assembly_->pair_cell(p);

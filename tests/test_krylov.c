@@ -9,7 +9,8 @@
  * with a reason naming GMRES and leaves the state untouched (the stepper
  * retries with a smaller dt), instead of ending the run. ILU(0) can be
  * asked for (0 is no default): its first step differs from ILU(2)'s. Bad
- * fill or tolerance, 0 included, is refused. */
+ * fill or tolerance, 0 included, is refused naming its key
+ * (solver.ilu_fill, solver.krylov_tol). */
 #include <string.h>
 
 #include "fixtures.h"
@@ -107,14 +108,19 @@ int main(int argc, char **argv) {
   sp_solver_destroy(&strict);
   free(y);
 
+  /* each bad value refused naming its own key */
   const struct {
     int fill;
     double tol;
-  } bad[] = {{-1, 1e-10}, {2, 1.5}, {2, -1e-8}, {2, 0}};
+    const char *key;
+  } bad[] = {{-1, 1e-10, "solver.ilu_fill"},
+             {2, 1.5, "solver.krylov_tol"},
+             {2, -1e-8, "solver.krylov_tol"},
+             {2, 0, "solver.krylov_tol"}};
   for (size_t b = 0; b < sizeof bad / sizeof bad[0]; ++b) {
     opt.ilu_fill = bad[b].fill;
     opt.krylov_tol = bad[b].tol;
-    expect_solver_refused(&opt, "solver.ilu_fill");
+    expect_solver_refused(&opt, bad[b].key);
   }
   for (int s = 0; s < 3; ++s) {
     sp_solver_destroy(&solvers[s]);

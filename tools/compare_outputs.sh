@@ -19,6 +19,8 @@
 # (seconds, assembly_s, factorisation_s, solves_s, supports_s), cells.csv,
 # divisions.csv. Prints a line per run (steps, divisions, support changes
 # reached) and exits 1 if any file differs or a run's status differs.
+# SET="k=v ...": more --set overrides for every run, after the script's
+# own (so SET=solver.linear=gmres_ilu compares that solver on every NP).
 # COMPARE_CACHE=DIR keeps OLD's outputs in DIR and reuses them when there
 # (for a series of comparisons against one baseline binary).
 set -uo pipefail
@@ -85,6 +87,7 @@ run_one() { # BINARY NP SCENE DIR
     launch=(mpiexec --allow-run-as-root --oversubscribe -np "$np")
     sets+=(--set solver.linear=superlu_dist)
   fi
+  for kv in ${SET:-}; do sets+=(--set "$kv"); done
   "${launch[@]}" "$sp" run "$scene" --quiet --out "$dir" "${sets[@]}" > "$dir.log" 2>&1
 }
 
@@ -94,11 +97,12 @@ for np in "${nps[@]}"; do
     if [ -n "$tolerance" ]; then
       sets=("time.max_steps=${cut[$scene]:-20}")
       [ "$np" -gt 1 ] && sets+=(solver.linear=superlu_dist)
+      for kv in ${SET:-}; do sets+=("$kv"); done
       tools/compare_tolerance.py "$old" "$new" "$np" "$scene" "${sets[@]}" ||
         failures=$((failures + 1))
       continue
     fi
-    name=$(echo "$scene" | tr / _)
+    name=$(echo "$scene${SET:+ $SET}" | tr '/ =' '___')
     a=$work/old_${np}_$name b=$work/new_${np}_$name
     if [ -n "${COMPARE_CACHE:-}" ]; then
       mkdir -p "$COMPARE_CACHE"
