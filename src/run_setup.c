@@ -97,7 +97,10 @@ static int maybe_local_supports(sp_run *run, const sp_scene *scene, int n_cells)
                           .lambda = run->opt.model.lambda,
                           .lambda_b = run->opt.model.lambda_b,
                           .fill = ly->fill == SP_FILL_RELAX ? SP_SUPPORT_FILL_RELAX
-                                                            : SP_SUPPORT_FILL_EDGE};
+                                                            : SP_SUPPORT_FILL_EDGE,
+                          .restore = ly->restore == SP_RESTORE_POTENTIAL
+                                         ? SP_SUPPORT_RESTORE_POTENTIAL
+                                         : SP_SUPPORT_RESTORE_INTERIOR};
   return sp_support_create(run->mesh, &sp, &run->support);
 }
 

@@ -197,6 +197,8 @@ static const cyaml_strval_t sp_shrink_words[] = {
     {"divisions", SP_SHRINK_DIVISIONS}, {"always", SP_SHRINK_ALWAYS}};
 static const cyaml_strval_t sp_fill_words[] = {{"edge", SP_FILL_EDGE},
                                                   {"relax", SP_FILL_RELAX}};
+static const cyaml_strval_t sp_restore_words[] = {{"interior", SP_RESTORE_INTERIOR},
+                                                     {"potential", SP_RESTORE_POTENTIAL}};
 static const cyaml_strval_t sp_axis_words[] = {
     {"long", SP_AXIS_LONG}, {"fixed", SP_AXIS_FIXED}, {"perpendicular", SP_AXIS_PERPENDICULAR}};
 static const cyaml_strval_t sp_indicator_words[] = {
@@ -592,6 +594,15 @@ static const sp_key sp_keys[] = {
              "the published runs), or that relaxed to the far field's "
              "equations at the free edge's chemical potential (relax: far "
              "fewer steps with narrow margins, docs/local-support.md)"),
+    KEY_ENUM(SP_SEC_LAYOUT, "restore", layout.restore, SP_RESTORE_POTENTIAL,
+             sp_restore_words, "-",
+             "local: how a support change gives each cell back the mass it "
+             "moved: a uniform shift of c_k over the cell's interior c_k >= "
+             "1/2 (interior: the published runs; a small, pressed cell's few "
+             "interior nodes can take shifts of 0.5 and more), or the far "
+             "field's response to one rise of the chemical potential over "
+             "the whole support, held down inside neighbours and the buffer "
+             "ring (potential: smooth, docs/local-support.md)"),
     /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
      * in E L^2, so delta is in E / L^6 (3D: L^5, E L^3, E / L^7) */
     KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),

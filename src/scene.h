@@ -256,6 +256,9 @@ typedef enum { SP_SHRINK_DIVISIONS = 0, SP_SHRINK_ALWAYS = 1 } sp_shrink_kind;
 /** What new (cell, node) pairs of a support change start from. */
 typedef enum { SP_FILL_EDGE = 0, SP_FILL_RELAX = 1 } sp_fill_kind;
 
+/** Where a support change restores each cell's mass. */
+typedef enum { SP_RESTORE_INTERIOR = 0, SP_RESTORE_POTENTIAL = 1 } sp_restore_kind;
+
 /** layout: where each cell's field lives. */
 typedef struct {
   sp_support_kind support; /**< auto | full (the paper) | local */
@@ -266,6 +269,7 @@ typedef struct {
   sp_shrink_kind shrink;   /**< local: shrink at every support change, or
                                 only the supports of dividing cells */
   sp_fill_kind fill;       /**< local: what new pairs of a change start from */
+  sp_restore_kind restore; /**< local: where a change restores the masses */
 } sp_scene_layout;
 
 /** How the shape term enters a step (src/shape.h). */

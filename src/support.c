@@ -384,6 +384,15 @@ static void edge_means(sp_support s, const sp_layout *layout, const double *stat
     }
 }
 
+/** The stiffness of a cell's far field for small c at node i: mu = c (2
+ *  alpha + 2 lambda sum_{l != k} c_l^2 + 2 lambda_b b), @p others the sum
+ *  of the other cells' c_l^2 there (b: the node's share of buffer
+ *  elements). */
+static double far_field_stiffness(sp_support s, double others, int i) {
+  return 2 * s->params.alpha + 2 * s->params.lambda * others +
+         2 * s->params.lambda_b * buffer_share(s, i);
+}
+
 /** New nodes continue the far field: the old edge's mean c_e where the
  *  cell is alone. Where a neighbour or the buffer ring is, the far field
  *  is held down: for small c, mu = c (2 alpha + 2 lambda sum_{l != k}
@@ -403,10 +412,8 @@ static void continue_far_field(sp_support s, const sp_layout *layout, const doub
       double others = 0; /* sum over l != k of c_l^2 at node i (old state) */
       for (int p = layout->node_start[i]; p < layout->node_start[i + 1]; ++p)
         if (layout->pair_cell[p] != k) others += state[2 * p] * state[2 * p];
-      const double free_stiffness = 2 * s->params.alpha;
-      const double stiffness = free_stiffness + 2 * s->params.lambda * others +
-                               2 * s->params.lambda_b * buffer_share(s, i);
-      next[2 * q] = stiffness > 0 ? edge_c[k] * free_stiffness / stiffness : edge_c[k];
+      const double stiffness = far_field_stiffness(s, others, i);
+      next[2 * q] = stiffness > 0 ? edge_c[k] * (2 * s->params.alpha) / stiffness : edge_c[k];
       next[2 * q + 1] = edge_mu[k];
     }
 }
@@ -509,8 +516,55 @@ int sp_support_fill(sp_support s, const sp_layout *layout, const double *state,
   return rc;
 }
 
-/** The interior of a cell, where support changes restore its mass. */
+/** The interior of a cell, where layout.restore = interior puts the mass
+ *  a support change moved. */
 #define SP_SUPPORT_INTERIOR 0.5
+
+/** The free far field's stiffness 2 alpha over that of pair @p q's cell
+ *  at node i of @p to (far_field_stiffness, the neighbours' values in
+ *  @p next): 1 where the cell is alone, ~1/21 inside a neighbour. */
+static double free_share(sp_support s, const sp_layout *to, const double *next, int i, int q) {
+  double others = 0;
+  for (int p = to->node_start[i]; p < to->node_start[i + 1]; ++p)
+    if (p != q) others += next[2 * p] * next[2 * p];
+  const double stiffness = far_field_stiffness(s, others, i);
+  return stiffness > 0 ? 2 * s->params.alpha / stiffness : 1.0;
+}
+
+/**
+ * Per pair of @p to, the profile of the shift that restores a cell's mass
+ * (the shift of cell k is delta_k x profile, delta_k set by the mass):
+ * - interior: 1 where c_k >= 1/2, else 0; a cell without interior nodes
+ *   takes it over its whole support (profile 1). No other cell and no
+ *   buffer ring is there (a shift where they are raises the repulsion or
+ *   buffer energy at first order) and f'(c) ~ 0; but a small, pressed
+ *   cell's few interior nodes take it all (shifts of 0.67 in the 3D run 5
+ *   at refinements 3: docs/local-support.md).
+ * - potential: the linear response of c_k to a uniform rise of its
+ *   chemical potential where its field is near a well (f'' = 2 alpha at
+ *   c = 0 and at c = 1): free_share, over the whole support. Smooth (no
+ *   step at the 1/2 level set), spread over the support, held down inside
+ *   neighbours (~ 1/21) and the buffer ring.
+ */
+static int restore_profile(sp_support s, const sp_layout *to, const double *next,
+                           double *profile) {
+  if (s->params.restore == SP_SUPPORT_RESTORE_POTENTIAL) {
+    for (int i = 0; i < to->n_nodes; ++i)
+      for (int q = to->node_start[i]; q < to->node_start[i + 1]; ++q)
+        profile[q] = free_share(s, to, next, i, q);
+    return SP_OK;
+  }
+  unsigned char *has_interior;
+  SP_ALLOC(has_interior, (size_t)to->n_cells + 1);
+  for (int q = 0; q < to->n_pairs; ++q) {
+    profile[q] = next[2 * q] >= SP_SUPPORT_INTERIOR;
+    if (profile[q] > 0) has_interior[to->pair_cell[q]] = 1;
+  }
+  for (int q = 0; q < to->n_pairs; ++q)
+    if (!has_interior[to->pair_cell[q]]) profile[q] = 1.0;
+  free(has_interior);
+  return SP_OK;
+}
 
 /** sp_support_rebuild with cell k's support widened by layers[k] layers of
  *  elements. */
@@ -532,37 +586,28 @@ static int rebuild_widened(sp_support s, const sp_layout *layout, const double *
   sp_cell_obs *before, *after;
   SP_ALLOC(before, nc);
   SP_ALLOC(after, nc);
-  /* per cell: the interior's and the support's weights */
-  double *acc = calloc(2 * (size_t)(nc ? nc : 1), sizeof(double));
-  double *w = malloc(sizeof(double) * (size_t)(to->n_pairs ? to->n_pairs : 1));
-  if (!acc || !w) rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
-  double *w_interior = acc, *w_all = acc + (size_t)nc;
+  /* per cell, the weight of its shift's profile; per pair, the weights and
+   * the profile */
+  double *delta = calloc((size_t)(nc ? nc : 1), sizeof(double));
+  const size_t np = (size_t)(to->n_pairs ? to->n_pairs : 1);
+  double *w = malloc(sizeof(double) * 2 * np), *profile = w ? w + np : NULL;
+  if (!delta || !w) rc = sp_error_set(SP_ERR_MEMORY, "out of memory restoring masses");
   if (rc == SP_OK) rc = sp_cells_observe(s->mesh, layout, state, 0.0, before);
   if (rc == SP_OK) rc = sp_cells_observe(s->mesh, to, next, 0.0, after);
-  /* A shift of c_k by d on a set of nodes changes the mass by d x (their
-   * weights) exactly. It goes on the cell's interior (c_k >= 1/2): there
-   * no other cell and no buffer ring is (a shift where a neighbour or the
-   * ring is raises the repulsion or buffer energy at first order) and
-   * f'(c) ~ 0; a cell without interior nodes takes it over its support. */
+  /* A shift of c_k by delta_k x profile changes the mass by delta_k x (sum
+   * of weight x profile over its pairs) exactly: the shape functions of a
+   * whole-element domain sum to one. */
   if (rc == SP_OK) rc = sp_cells_pair_weights(s->mesh, to, w);
-  for (int q = 0; q < to->n_pairs && rc == SP_OK; ++q) {
-    const int k = to->pair_cell[q];
-    w_all[k] += w[q];
-    if (next[2 * q] >= SP_SUPPORT_INTERIOR) w_interior[k] += w[q];
-  }
+  if (rc == SP_OK) rc = restore_profile(s, to, next, profile);
+  for (int q = 0; q < to->n_pairs && rc == SP_OK; ++q) delta[to->pair_cell[q]] += w[q] * profile[q];
   for (int k = 0; k < nc && rc == SP_OK; ++k) {
     const double change = after[k].mass - before[k].mass;
     const double rel = before[k].mass != 0 ? fabs(change / before[k].mass) : fabs(change);
     if (rel > *mass_correction) *mass_correction = rel;
-    /* the shift of cell k, kept in w_all[k]; w_interior[k] > 0 marks an
-     * interior to shift (a cell without one shifts its whole support) */
-    const double weight = w_interior[k] > 0 ? w_interior[k] : w_all[k];
-    w_all[k] = weight > 0 ? -change / weight : 0.0;
+    delta[k] = delta[k] > 0 ? -change / delta[k] : 0.0;
   }
-  for (int q = 0; q < to->n_pairs && rc == SP_OK; ++q) {
-    const int k = to->pair_cell[q];
-    if (w_interior[k] <= 0 || next[2 * q] >= SP_SUPPORT_INTERIOR) next[2 * q] += w_all[k];
-  }
+  for (int q = 0; q < to->n_pairs && rc == SP_OK; ++q)
+    next[2 * q] += delta[to->pair_cell[q]] * profile[q];
   /* The total mass before and after, integral of sum_k c_k: the cells'
    * observed masses on the old layout, sum over pairs of (weight x c) on
    * the new one (the same quadrature). */
@@ -571,7 +616,7 @@ static int rebuild_widened(sp_support s, const sp_layout *layout, const double *
   for (int k = 0; k < nc && rc == SP_OK; ++k) total_before += before[k].mass;
   if (rc == SP_OK)
     *mass_dropped = fabs(total_after - total_before) / (total_before != 0 ? fabs(total_before) : 1);
-  free(acc);
+  free(delta);
   free(w);
   free(before);
   free(after);

@@ -33,6 +33,13 @@ typedef enum {
   SP_SUPPORT_FILL_RELAX = 1 /**< that, relaxed to the far field's equations */
 } sp_support_fill_kind;
 
+/** Where a support change restores each cell's mass (the mass its fill
+ *  added and its shrinking dropped). */
+typedef enum {
+  SP_SUPPORT_RESTORE_INTERIOR = 0, /**< a uniform shift of c_k where c_k >= 1/2 */
+  SP_SUPPORT_RESTORE_POTENTIAL = 1 /**< delta x 2 alpha / (the node's stiffness), everywhere */
+} sp_support_restore_kind;
+
 /** Parameters (lengths in the model's length unit). */
 typedef struct {
   double margin;         /**< support = elements within this of the core */
@@ -43,6 +50,7 @@ typedef struct {
    * 2 alpha, the repulsion lambda and the buffer ring's lambda_b. */
   double alpha, kappa, lambda, lambda_b;
   sp_support_fill_kind fill; /**< layout.fill */
+  sp_support_restore_kind restore; /**< layout.restore */
 } sp_support_params;
 
 /** @brief Node adjacency of a mesh and the parameters. */

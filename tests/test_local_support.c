@@ -144,7 +144,8 @@ typedef struct {
 static const double rb_cx[2] = {0.40, 0.63}, rb_r[2] = {0.12, 0.10}, rb_c_e = 0.02,
                     rb_mu = 0.1, rb_kappa = 1e-3, rb_alpha = 4, rb_lambda = 100;
 
-static void rebuild_setup(sp_support_fill_kind fill, double mu, rebuild_case *rc) {
+static void rebuild_setup(sp_support_fill_kind fill, sp_support_restore_kind restore, double mu,
+                          rebuild_case *rc) {
   CHECK_OK(sp_mesh_rectangle(0, 0, 1, 0.6, 80, 48, &rc->mesh));
   const int nn = rc->mesh->n_nodes;
   const double d = sqrt(rb_kappa / (2 * rb_alpha));
@@ -160,7 +161,8 @@ static void rebuild_setup(sp_support_fill_kind fill, double mu, rebuild_case *rc
     }
   sp_support_params narrow = {.margin = 3 * d, .core_threshold = 0.1, .grow_threshold = 0.1,
                               .band = 2 * d, .alpha = rb_alpha, .kappa = rb_kappa,
-                              .lambda = rb_lambda, .lambda_b = 0, .fill = fill};
+                              .lambda = rb_lambda, .lambda_b = 0, .fill = fill,
+                              .restore = restore};
   sp_support_params wide = narrow;
   wide.margin = 10 * d;
   CHECK_OK(sp_support_create(rc->mesh, &narrow, &rc->s_narrow));
@@ -194,7 +196,7 @@ static void rebuild_free(rebuild_case *rc) {
  * the rebuild uses equal each cell's node weights exactly. */
 static void test_rebuild_growth(void) {
   rebuild_case rc;
-  rebuild_setup(SP_SUPPORT_FILL_EDGE, rb_mu, &rc);
+  rebuild_setup(SP_SUPPORT_FILL_EDGE, SP_SUPPORT_RESTORE_INTERIOR, rb_mu, &rc);
   const sp_mesh *mesh = rc.mesh;
   const int nn = mesh->n_nodes;
   const double c_e = rb_c_e, alpha = rb_alpha, lambda = rb_lambda;
@@ -282,7 +284,7 @@ static void test_rebuild_growth(void) {
  * inside the neighbour stay below that (held down by the repulsion). */
 static void test_rebuild_relax(void) {
   rebuild_case rc;
-  rebuild_setup(SP_SUPPORT_FILL_RELAX, rb_mu, &rc);
+  rebuild_setup(SP_SUPPORT_FILL_RELAX, SP_SUPPORT_RESTORE_INTERIOR, rb_mu, &rc);
   const sp_mesh *mesh = rc.mesh;
   const int nn = mesh->n_nodes;
   const double alpha = rb_alpha, mu = rb_mu, d = sqrt(rb_kappa / (2 * rb_alpha));
@@ -336,8 +338,8 @@ static void test_rebuild_relax(void) {
  * spinodal, and the masses are kept. */
 static void test_rebuild_relax_unstable(void) {
   rebuild_case relax, edge;
-  rebuild_setup(SP_SUPPORT_FILL_RELAX, 1.0, &relax);
-  rebuild_setup(SP_SUPPORT_FILL_EDGE, 1.0, &edge);
+  rebuild_setup(SP_SUPPORT_FILL_RELAX, SP_SUPPORT_RESTORE_INTERIOR, 1.0, &relax);
+  rebuild_setup(SP_SUPPORT_FILL_EDGE, SP_SUPPORT_RESTORE_INTERIOR, 1.0, &edge);
   CHECK(relax.grown->n_pairs == edge.grown->n_pairs, "layouts differ: %d vs %d pairs",
         relax.grown->n_pairs, edge.grown->n_pairs);
   int n_new = 0;
@@ -361,11 +363,76 @@ static void test_rebuild_relax_unstable(void) {
   rebuild_free(&edge);
 }
 
+/* The same growth with layout.restore = potential (support.c,
+ * restore_profile): the mass the fill added comes back as one shift of
+ * cell 0's chemical potential, each value moving by delta x 2 alpha /
+ * (2 alpha + 2 lambda c_1^2) (no buffer ring here), over the whole
+ * support: checked value by value against the fill (sp_support_fill) to
+ * 1e-12 of delta, with delta < 0 (the fill added far-field mass). Cell 1
+ * (support unchanged, mass unchanged) keeps its values; the masses are
+ * kept to round-off. The shift is spread: its largest value is below the
+ * interior rule's uniform shift of the same growth, which steps at the 1/2
+ * level set. */
+static void test_rebuild_potential(void) {
+  rebuild_case pot, inter;
+  rebuild_setup(SP_SUPPORT_FILL_EDGE, SP_SUPPORT_RESTORE_POTENTIAL, rb_mu, &pot);
+  rebuild_setup(SP_SUPPORT_FILL_EDGE, SP_SUPPORT_RESTORE_INTERIOR, rb_mu, &inter);
+  const sp_layout *grown = pot.grown;
+  CHECK(grown->n_pairs == inter.grown->n_pairs, "layouts differ: %d vs %d pairs",
+        grown->n_pairs, inter.grown->n_pairs);
+  double *fill = malloc(sizeof(double) * 2 * (size_t)grown->n_pairs);
+  CHECK_OK(sp_support_fill(pot.s_wide, pot.layout, pot.st, grown, fill));
+  /* delta from the freest pair of cell 0, then every pair against it */
+  double delta = 0, best_share = 0, worst = 0, cell1 = 0, largest = 0, largest_inter = 0;
+  int n0 = 0;
+  for (int i = 0; i < pot.mesh->n_nodes; ++i) {
+    const int q = sp_layout_pair(grown, 0, i), q1 = sp_layout_pair(grown, 1, i);
+    if (q < 0) continue;
+    const double c1 = fill[2 * q1];
+    const double share = 2 * rb_alpha / (2 * rb_alpha + 2 * rb_lambda * c1 * c1);
+    if (share > best_share) {
+      best_share = share;
+      delta = (pot.next[2 * q] - fill[2 * q]) / share;
+    }
+  }
+  for (int i = 0; i < pot.mesh->n_nodes; ++i) {
+    const int q = sp_layout_pair(grown, 0, i), q1 = sp_layout_pair(grown, 1, i);
+    cell1 = fmax(cell1, fabs(pot.next[2 * q1] - fill[2 * q1]));
+    if (q < 0) continue;
+    ++n0;
+    const double c1 = fill[2 * q1];
+    const double share = 2 * rb_alpha / (2 * rb_alpha + 2 * rb_lambda * c1 * c1);
+    worst = fmax(worst, fabs(pot.next[2 * q] - fill[2 * q] - delta * share));
+    largest = fmax(largest, fabs(pot.next[2 * q] - fill[2 * q]));
+    largest_inter = fmax(largest_inter, fabs(inter.next[2 * q] - fill[2 * q]));
+  }
+  sp_cell_obs before[2], after[2];
+  CHECK_OK(sp_cells_observe(pot.mesh, pot.layout, pot.st, 0.0, before));
+  CHECK_OK(sp_cells_observe(pot.mesh, grown, pot.next, 0.0, after));
+  printf("rebuild (potential): %d pairs of cell 0, delta %.4e, largest departure from delta x "
+         "share %.1e, cell 1 moved %.1e; largest change %.3e (interior rule %.3e); mass %.17g "
+         "-> %.17g\n", n0, delta, worst, cell1, largest, largest_inter, before[0].mass,
+         after[0].mass);
+  CHECK(delta < 0, "the fill added mass: delta should be < 0, is %.3e", delta);
+  CHECK(worst <= 1e-12 * fabs(delta), "a value departs from delta x share by %.3e", worst);
+  CHECK(cell1 <= 1e-15, "cell 1 (mass unchanged) moved by %.3e", cell1);
+  CHECK(largest < largest_inter, "the potential shift %.3e is not below the interior's %.3e",
+        largest, largest_inter);
+  CHECK(pot.dropped <= 1e-13, "the rebuild dropped %.3e of the mass", pot.dropped);
+  for (int k = 0; k < 2; ++k)
+    CHECK(fabs(after[k].mass - before[k].mass) <= 1e-13 * before[k].mass,
+          "cell %d mass %.17g -> %.17g", k + 1, before[k].mass, after[k].mass);
+  free(fill);
+  rebuild_free(&pot);
+  rebuild_free(&inter);
+}
+
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   test_rebuild_growth();
   test_rebuild_relax();
   test_rebuild_relax_unstable();
+  test_rebuild_potential();
   /* 1. local = full on a short scene with a wide margin */
   const char *full_set[] = {"layout.support=full"};
   const char *wide_set[] = {"layout.margin=40", "layout.band=10"};
