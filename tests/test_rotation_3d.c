@@ -1,5 +1,6 @@
 /* Frame indifference of the 3D model (issue 29): a scene and the same scene
- * turned by the rotation P (x, y, z) -> (y, z, x) give the same run, turned.
+ * turned by the rotation P (x, y, z) -> (y, z, x), or by the quarter turn
+ * about z Q (x, y, z) -> (y, -x, z), give the same run, turned.
  *
  * Scene A: a box of 14 x 12 x 10 hexahedra (0.56 x 0.48 x 0.40: cubes of
  * side 0.04), three cells off-centre and near each other (a prolate
@@ -15,7 +16,9 @@
  * turned, node for node, with its hexahedra still positively oriented, and
  * B's discrete problem is A's turned: the runs may differ only in round-off
  * (nodes and elements are numbered otherwise, so every sum is taken in
- * another order, and the LU's pivots differ).
+ * another order, and the LU's pivots differ). Scene C: A turned by Q the
+ * same way (12 x 14 x 10 hexahedra; a point's new y is the box's width
+ * minus its x).
  *
  * Asserted, at every step: the energy equal to 1e-10 relative, every cell's
  * mass equal to 1e-10 relative, its centre turned by P to 1e-10 (absolute;
@@ -33,9 +36,10 @@
  * another LU ordering or BLAS may make more; 1e-10 leaves that room and is
  * still orders of magnitude below what a frame-dependent discretisation
  * does to these quantities (docs/3d.md: B with one cell's semi-axes left
- * unturned). The daughters' labels follow the cut normal's sign: when P
- * flips it (see above), the daughters swap their labels, which the
- * comparison follows. */
+ * unturned). The daughters' labels follow the cut normal's sign: when a
+ * turn flips it (see above), the daughters swap their labels, which the
+ * comparison follows. P keeps this scene's sign, Q flips it (asserted:
+ * both paths are taken). */
 #include <string.h>
 
 #include "check.h"
@@ -62,19 +66,39 @@ static const cell_spec cells[3] = {
     {{0.37, 0.34, 0.25}, {0, 0, 0}, 0.075, {0, 0, 0}},
 };
 
-/** (P v)_j = v_{(j + 1) mod 3} when @p turn, else v itself. */
+/** The turns: 0 none, 1 P (x, y, z) -> (y, z, x), 2 Q (x, y, z) -> (y,
+ *  -x, z) (a quarter turn about z): (R v)_j = sign_j v_{perm_j}. */
+static const int turn_perm[3][3] = {{0, 1, 2}, {1, 2, 0}, {1, 0, 2}};
+static const double turn_sign[3][3] = {{1, 1, 1}, {1, 1, 1}, {1, -1, 1}};
+
+/** The vector @p v turned by turn @p turn. */
 static void turned(const double v[3], int turn, double out[3]) {
-  for (int j = 0; j < 3; ++j) out[j] = v[turn ? (j + 1) % 3 : j];
+  for (int j = 0; j < 3; ++j) out[j] = turn_sign[turn][j] * v[turn_perm[turn][j]];
 }
 
-/** Write scene A (@p turn 0) or B (1) to @p path. */
+/** The point @p p of scene A's box turned into the turned scene's box (a
+ *  reversed axis runs from the box's far side: x' = L - x). */
+static void turned_point(const double p[3], int turn, double out[3]) {
+  for (int j = 0; j < 3; ++j) {
+    const int i = turn_perm[turn][j];
+    out[j] = turn_sign[turn][j] > 0 ? p[i] : box[i] - p[i];
+  }
+}
+
+/** A length triple (extents, semi-axes) turned: its components permuted. */
+static void turned_lengths(const double v[3], int turn, double out[3]) {
+  for (int j = 0; j < 3; ++j) out[j] = v[turn_perm[turn][j]];
+}
+
+/** Write scene A (@p turn 0) or A turned (1: B, 2: C) to @p path. */
 static void write_scene(const char *path, int turn) {
   FILE *f = fopen(path, "w");
   CHECK(f != NULL, "cannot write %s", path);
   if (!f) exit(1);
   double L[3];
-  turned(box, turn, L);
-  const int n[3] = {counts[turn ? 1 : 0], counts[turn ? 2 : 1], counts[turn ? 0 : 2]};
+  turned_lengths(box, turn, L);
+  const int *perm = turn_perm[turn];
+  const int n[3] = {counts[perm[0]], counts[perm[1]], counts[perm[2]]};
   fprintf(f, "mesh: {type: box, x0: 0, y0: 0, z0: 0, x1: %.17g, y1: %.17g, z1: %.17g, "
              "nx: %d, ny: %d, nz: %d}\n", L[0], L[1], L[2], n[0], n[1], n[2]);
   fprintf(f, "model: {alpha: 4, kappa: 4.0e-3, lambda: 100, mobility: 1}\n"
@@ -88,10 +112,10 @@ static void write_scene(const char *path, int turn) {
   static const char *xyz = "xyz";
   for (int k = 0; k < 3; ++k) {
     double c[3], s[3], a[3];
-    turned(cells[k].c, turn, c);
+    turned_point(cells[k].c, turn, c);
     turned(cells[k].axis, turn, a);
-    /* a turned cell's semi_x lies along its axis, which P turns */
-    turned(cells[k].semi, turn && a[0] == 0 && a[1] == 0 && a[2] == 0, s);
+    /* a turned cell's semi_x lies along its axis, which the turn turns */
+    turned_lengths(cells[k].semi, a[0] == 0 && a[1] == 0 && a[2] == 0 ? turn : 0, s);
     fprintf(f, "  - {x: %.17g, y: %.17g, z: %.17g, radius: %.17g", c[0], c[1], c[2],
             cells[k].radius);
     for (int j = 0; j < 3; ++j)
@@ -103,7 +127,7 @@ static void write_scene(const char *path, int turn) {
   fclose(f);
 }
 
-/** Write and run scene A or B into @p out; the summary. */
+/** Write and run scene A, B or C into @p out; the summary. */
 static sp_run_summary run(int turn, const char *out) {
   char path[256];
   snprintf(path, sizeof path, "%s.yaml", out);
@@ -148,8 +172,10 @@ static void read_cells(const char *dir, cells_log *log) {
   }
 }
 
-/** Cell @p ka at step @p s of run A against cell @p kb of run B. */
-static void compare_cell(const cells_log *A, const cells_log *B, int s, int ka, int kb) {
+/** Cell @p ka at step @p s of run A against cell @p kb of run B, A's
+ *  turned by @p turn. */
+static void compare_cell(const cells_log *A, const cells_log *B, int turn, int s, int ka,
+                         int kb) {
   const double m = rel(A->mass[s][ka], B->mass[s][kb]);
   worst_mass = fmax(worst_mass, m);
   CHECK(m <= TOL, "step %d cell %d/%d: mass %.17g turned %.17g", s, ka + 1, kb + 1,
@@ -160,8 +186,8 @@ static void compare_cell(const cells_log *A, const cells_log *B, int s, int ka, 
     va[j] = A->v[j][s][ka];
     vb[j] = B->v[j][s][kb];
   }
-  turned(ca, 1, pc);
-  turned(va, 1, pv);
+  turned_point(ca, turn, pc);
+  turned(va, turn, pv);
   for (int j = 0; j < 3; ++j) {
     const double d = fabs(pc[j] - B->c[j][s][kb]);
     worst_centre = fmax(worst_centre, d);
@@ -202,37 +228,35 @@ static void read_division(const char *dir, division_row *r) {
   csv_free(&t);
 }
 
-int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  const char *a_dir = "test_rotation_3d_a", *b_dir = "test_rotation_3d_b";
-  const sp_run_summary sa = run(0, a_dir), sb = run(1, b_dir);
-  CHECK(sa.steps == 5 && sb.steps == 5 && sa.divisions == 1 && sb.divisions == 1 &&
-            sa.n_cells == 4 && sb.n_cells == 4,
-        "A: %d steps, %d divisions, %d cells; B: %d, %d, %d", sa.steps, sa.divisions,
-        sa.n_cells, sb.steps, sb.divisions, sb.n_cells);
+/** Run A against the run of A turned by @p turn in @p b_dir: every step's
+ *  energy, cells and the division; returns whether the turn flipped the
+ *  cut normal's sign (the daughters' labels swapped). */
+static int compare_runs(const char *a_dir, const char *b_dir, int turn) {
+  worst_mass = worst_centre = worst_moment = worst_axis = 0;
   const double worst_energy = energy_difference(a_dir, b_dir); /* (same t and cells at every step) */
-  CHECK(worst_energy <= TOL, "the energies differ by %.3g (relative)", worst_energy);
+  CHECK(worst_energy <= TOL, "turn %d: the energies differ by %.3g (relative)", turn,
+        worst_energy);
   /* the division: same step and t, the cut normal turned (up to its sign) */
   division_row da, db;
   read_division(a_dir, &da);
   read_division(b_dir, &db);
   double pn[3];
-  turned(da.normal, 1, pn);
+  turned(da.normal, turn, pn);
   const double flip = pn[0] * db.normal[0] + pn[1] * db.normal[1] + pn[2] * db.normal[2];
   const double normal_angle = line_angle(pn, db.normal);
-  printf("  division at step %d (A) and %d (B): normal P n_A (%.6f, %.6f, %.6f), n_B "
-         "(%.6f, %.6f, %.6f), %.3g rad apart, %s sign\n", da.step, db.step, pn[0], pn[1],
+  printf("  turn %d: division at step %d (A) and %d: normal R n_A (%.6f, %.6f, %.6f), n "
+         "(%.6f, %.6f, %.6f), %.3g rad apart, %s sign\n", turn, da.step, db.step, pn[0], pn[1],
          pn[2], db.normal[0], db.normal[1], db.normal[2], normal_angle,
          flip < 0 ? "the opposite" : "the same");
   CHECK(da.step == 3 && db.step == 3 && da.t == db.t, "divisions at steps %d, %d, t %.17g, %.17g",
         da.step, db.step, da.t, db.t);
   CHECK(da.parent == 1 && da.child == 4 && db.parent == 1 && db.child == 4,
-        "A: %d -> %d, B: %d -> %d", da.parent, da.child, db.parent, db.child);
+        "A: %d -> %d, turned: %d -> %d", da.parent, da.child, db.parent, db.child);
   CHECK(normal_angle <= TOL / 0.01, "the cut normals are %.3g rad apart", normal_angle);
   CHECK(rel(da.before, db.before) <= TOL, "parent mass %.17g, %.17g", da.before, db.before);
-  /* a flipped normal swaps the daughters' labels: B's 1 is A's 4 */
+  /* a flipped normal swaps the daughters' labels: the turned run's 1 is A's 4 */
   CHECK(rel(flip < 0 ? da.b : da.a, db.a) <= TOL && rel(flip < 0 ? da.a : da.b, db.b) <= TOL,
-        "daughters' masses: A %.17g, %.17g; B %.17g, %.17g", da.a, da.b, db.a, db.b);
+        "daughters' masses: A %.17g, %.17g; turned %.17g, %.17g", da.a, da.b, db.a, db.b);
   static cells_log A, B;
   read_cells(a_dir, &A);
   read_cells(b_dir, &B);
@@ -242,11 +266,28 @@ int main(int argc, char **argv) {
       const int ka = flip < 0 && s >= da.step && (kb == 0 || kb == 3) ? 3 - kb : kb;
       CHECK(isnan(A.mass[s][ka]) == isnan(B.mass[s][kb]), "step %d: cell %d/%d in one run only",
             s, ka + 1, kb + 1);
-      if (!isnan(A.mass[s][ka]) && !isnan(B.mass[s][kb])) compare_cell(&A, &B, s, ka, kb);
+      if (!isnan(A.mass[s][ka]) && !isnan(B.mass[s][kb])) compare_cell(&A, &B, turn, s, ka, kb);
     }
-  printf("  largest differences: energy %.3g and mass %.3g (relative), centre %.3g, moments "
-         "%.3g (relative), long axis angle x gap %.3g rad\n", worst_energy, worst_mass,
-         worst_centre, worst_moment, worst_axis);
+  printf("  turn %d: largest differences: energy %.3g and mass %.3g (relative), centre %.3g, "
+         "moments %.3g (relative), long axis angle x gap %.3g rad\n", turn, worst_energy,
+         worst_mass, worst_centre, worst_moment, worst_axis);
+  return flip < 0;
+}
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  const char *dirs[3] = {"test_rotation_3d_a", "test_rotation_3d_b", "test_rotation_3d_c"};
+  for (int turn = 0; turn < 3; ++turn) {
+    const sp_run_summary sum = run(turn, dirs[turn]);
+    CHECK(sum.steps == 5 && sum.divisions == 1 && sum.n_cells == 4,
+          "turn %d: %d steps, %d divisions, %d cells", turn, sum.steps, sum.divisions,
+          sum.n_cells);
+  }
+  /* P keeps the sign rule's choice of the cut normal here, Q flips it: both
+   * label paths are taken */
+  CHECK(!compare_runs(dirs[0], dirs[1], 1), "P flipped the cut normal's sign");
+  CHECK(compare_runs(dirs[0], dirs[2], 2), "Q kept the cut normal's sign: the label swap is "
+        "not exercised");
   MPI_Finalize();
   TEST_DONE();
 }
