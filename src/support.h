@@ -12,8 +12,10 @@
  * the far-field value in equilibrium with the old edge's mean chemical
  * potential, relaxed to the far field's equations with layout.fill = relax
  * (far_field.h; sp_support_rebuild), and each cell's mass is then
- * restored exactly by a uniform shift of c_k over its interior (c_k >= 1/2).
- * The mass changes that shift corrects are reported.
+ * restored exactly by one shift of its chemical potential over its whole
+ * support (layout.restore = potential) or a uniform shift of c_k over its
+ * interior c_k >= 1/2 (interior). The mass changes that shift corrects are
+ * reported.
  */
 #ifndef SP_SUPPORT_H
 #define SP_SUPPORT_H
