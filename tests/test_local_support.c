@@ -476,6 +476,19 @@ int main(int argc, char **argv) {
   for (int k = 0; k < 2; ++k)
     CHECK(fabs(m1[k] - m0[k]) <= 1e-10 * m0[k], "cell %d mass %.17g -> %.17g", k + 1, m0[k],
           m1[k]);
+  /* the same push with the interior restore: the same masses kept, and the
+   * potential restore (the default) raises the energy less at its changes
+   * (docs/local-support.md, "Where a change restores the mass") */
+  const char *interior_set[] = {"layout.restore=interior"};
+  sp_run_summary pi = run("local_push.yaml", 1, interior_set, "local_push_interior");
+  printf("pushed cell, layout.restore interior: %d support changes, largest energy rise at a "
+         "change %.2e (potential %.2e)\n", pi.layout_changes, pi.support_energy_rise,
+         p.support_energy_rise);
+  CHECK(pi.support_mass_dropped <= 1e-10, "interior: support changes dropped %.3e of the mass",
+        pi.support_mass_dropped);
+  CHECK(pi.layout_changes >= 1 && p.support_energy_rise < pi.support_energy_rise,
+        "the potential restore rose %.3e at a change, the interior one %.3e",
+        p.support_energy_rise, pi.support_energy_rise);
 
   /* 3. supports clipped by the ellipse and its buffer ring */
   sp_run_summary b = run("local_edge.yaml", 0, NULL, "local_edge");
