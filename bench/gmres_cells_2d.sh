@@ -27,8 +27,8 @@ for spec in "${scenes[@]}"; do
   echo "== $spec"
   OUT=$tmp/$name ab_runs "$scene" mumps solver.linear=mumps gmres_cells solver.linear=gmres_cells \
     "${extra[@]}"
-  a=$(sed -n 's/^mumps: mumps: \([0-9.]*\) s wall.*/\1/p' "$tmp/$name/mumps.summary")
-  b=$(sed -n 's/^gmres_cells: gmres_cells: \([0-9.]*\) s wall.*/\1/p' "$tmp/$name/gmres_cells.summary")
+  a=$(summary_wall mumps "$tmp/$name/mumps.summary")
+  b=$(summary_wall gmres_cells "$tmp/$name/gmres_cells.summary")
   rows+=("$(awk -v n="$spec" -v a="$a" -v b="$b" 'BEGIN { printf "| %s | %.1f | %.1f | %.2f |", n, a, b, b / a }')")
 done
 echo

@@ -101,6 +101,12 @@ compare_runs() {
   cut -d, -f1-5 "$b/divisions.csv" | sed 's/^/  /'
 }
 
+# summary_wall RUN FILE: the wall seconds ab_runs recorded for RUN in its
+# summary FILE.
+summary_wall() {
+  sed -n "s/^$1: $1: \([0-9.]*\) s wall.*/\1/p" "$2"
+}
+
 # ab_runs SCENE NAME_A SET_A NAME_B SET_B [--set k=v ...]: the scene run
 # twice in one go, with --set SET_A (the baseline) and with --set SET_B,
 # each with its wall time, peak memory, phases, Newton iterations,
@@ -120,7 +126,7 @@ ab_runs() {
     /usr/bin/time -f "$run: %e s wall, %M kB peak (rank 0)" "${launch[@]}" "$bin" run "$scene" \
         --out "$out/$run" --set "${sets[$i]}" --set output.pictures=false "$@" 2>&1 |
       grep -v "^softpack: step\|^  " | sed "s/^/$run: /" | tee "$out/$run.summary"
-    wall[$i]=$(sed -n "s/^$run: $run: \([0-9.]*\) s wall.*/\1/p" "$out/$run.summary")
+    wall[$i]=$(summary_wall "$run" "$out/$run.summary")
   done
   awk -v a="${wall[0]}" -v b="${wall[1]}" -v na="${names[0]}" -v nb="${names[1]}" \
     'BEGIN { if (a > 0 && b > 0) printf "wall time %s / %s: %.2f\n", na, nb, a / b }'

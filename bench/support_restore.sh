@@ -38,7 +38,7 @@ for spec in "${specs[@]}"; do
     s=$out/$name/$rule.summary
     rows+=("$(sed -n 's/.*local supports: \([0-9]*\) changes.*restored \([0-9.e+-]*\),.*rise at a change \([0-9.e+-]*\), at most \([0-9]*\) unknowns.*/\1 \2 \3 \4/p' "$s" |
       awk -v n="$name" -v r="$rule" -v st="$(sed -n 's/.* \([0-9]*\) steps to .*(\([0-9]*\) failed.*/\1 \2/p' "$s")" \
-        -v w="$(sed -n "s/^$rule: $rule: \([0-9.]*\) s wall.*/\1/p" "$s")" \
+        -v w="$(summary_wall "$rule" "$s")" \
         '{ split(st, a, " "); printf "| %s | %s | %.3g | %.3g | %d | %d | %d | %d | %.1f |", n, r, $3, $2, $1, a[1], a[2], $4, w }')")
   done
 done
