@@ -363,6 +363,12 @@ static void test_rebuild_relax_unstable(void) {
   rebuild_free(&edge);
 }
 
+/** The free share of cell 0 at a node where cell 1 has c1 (no buffer
+ *  ring): 2 alpha / (2 alpha + 2 lambda c1^2), restore_profile's rule. */
+static double rb_free_share(double c1) {
+  return 2 * rb_alpha / (2 * rb_alpha + 2 * rb_lambda * c1 * c1);
+}
+
 /* The same growth with layout.restore = potential (support.c,
  * restore_profile): the mass the fill added comes back as one shift of
  * cell 0's chemical potential, each value moving by delta x 2 alpha /
@@ -388,8 +394,7 @@ static void test_rebuild_potential(void) {
   for (int i = 0; i < pot.mesh->n_nodes; ++i) {
     const int q = sp_layout_pair(grown, 0, i), q1 = sp_layout_pair(grown, 1, i);
     if (q < 0) continue;
-    const double c1 = fill[2 * q1];
-    const double share = 2 * rb_alpha / (2 * rb_alpha + 2 * rb_lambda * c1 * c1);
+    const double share = rb_free_share(fill[2 * q1]);
     if (share > best_share) {
       best_share = share;
       delta = (pot.next[2 * q] - fill[2 * q]) / share;
@@ -400,8 +405,7 @@ static void test_rebuild_potential(void) {
     cell1 = fmax(cell1, fabs(pot.next[2 * q1] - fill[2 * q1]));
     if (q < 0) continue;
     ++n0;
-    const double c1 = fill[2 * q1];
-    const double share = 2 * rb_alpha / (2 * rb_alpha + 2 * rb_lambda * c1 * c1);
+    const double share = rb_free_share(fill[2 * q1]);
     worst = fmax(worst, fabs(pot.next[2 * q] - fill[2 * q] - delta * share));
     largest = fmax(largest, fabs(pot.next[2 * q] - fill[2 * q]));
     largest_inter = fmax(largest_inter, fabs(inter.next[2 * q] - fill[2 * q]));
