@@ -20,9 +20,13 @@ typedef enum {
   SP_NEWTON_NOT_FINITE,     /**< a residual norm was not finite */
   SP_NEWTON_LINEAR_FAILED,  /**< a linear solve failed (reason says how) */
   SP_NEWTON_OTHER_FAILURE,  /**< NOX stopped for another reason */
-  SP_NEWTON_INTERRUPTED     /**< sp_step_data.interrupt asked it to stop (a
+  SP_NEWTON_INTERRUPTED,    /**< sp_step_data.interrupt asked it to stop (a
                                  stop signal during the step): not a failure
                                  of the step, which is dropped, not retried */
+  SP_NEWTON_OUT_OF_MEMORY   /**< the linear solver could not allocate its
+                                 factors (reason says how much it asked
+                                 for): a smaller step has a matrix of the
+                                 same size, so the run ends, not retried */
 } sp_newton_failure;
 
 #endif

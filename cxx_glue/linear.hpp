@@ -46,6 +46,10 @@ class DirectSolver {
   // another failure, with why set (possibly on some ranks only: the caller
   // makes the ranks agree).
   virtual bool factor(const CsrRows &A, bool same_pattern, std::string &why) = 0;
+  // After a failed factor(): whether it failed for want of memory (an
+  // allocation of the factors refused), which a smaller time step, the
+  // same matrix's size, would not cure. On this rank.
+  virtual bool out_of_memory() const { return false; }
   // Solve A x = b with the last factorisation; b and x are this rank's
   // n_rows entries.
   virtual bool solve(const double *b, double *x, std::string &why) = 0;

@@ -129,6 +129,7 @@ class CellBlockSolver final : public DirectSolver {
 
   long iterations() const override { return iterations_; }
   int symbolic_count() const override { return inner_->symbolic_count(); }
+  bool out_of_memory() const override { return inner_->out_of_memory(); }
 
  private:
   // A new pattern: the Tpetra copy of A, the filter to its cell-diagonal

@@ -89,6 +89,7 @@ class Gathered final : public DirectSolver {
     int mine = rank_ == 0 ? serial_->symbolic_count() : 0;
     return mine;  // meaningful on rank 0
   }
+  bool out_of_memory() const override { return rank_ == 0 && serial_->out_of_memory(); }
 
  private:
   // Ranks > 0 wait for rank 0's factorisation without spinning: the next

@@ -28,6 +28,7 @@ class Klu final : public DirectSolver {
 
   bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
     klu_free_numeric(&numeric_, &common_);
+    out_of_memory_ = false;
     if (A.first_row != 0 || A.n_rows != A.n_global) {
       why = "KLU: the serial solver needs all rows on one process";
       return false;
@@ -40,6 +41,7 @@ class Klu final : public DirectSolver {
       symbolic_ = klu_analyze(n, Ap, Ai, &common_);
       ++analyses_;
       if (!symbolic_) {
+        out_of_memory_ = common_.status == KLU_OUT_OF_MEMORY;
         why = "KLU: analysis failed (status " + std::to_string(common_.status) + ")";
         return false;
       }
@@ -47,6 +49,7 @@ class Klu final : public DirectSolver {
     }
     numeric_ = klu_factor(Ap, Ai, A.val, symbolic_, &common_);
     if (!numeric_ || common_.status != KLU_OK) {
+      out_of_memory_ = common_.status == KLU_OUT_OF_MEMORY;
       klu_free_numeric(&numeric_, &common_);
       why = common_.status == KLU_SINGULAR
                 ? "KLU: the matrix is singular (zero pivot in column " +
@@ -76,12 +79,14 @@ class Klu final : public DirectSolver {
   }
 
   int symbolic_count() const override { return analyses_; }
+  bool out_of_memory() const override { return out_of_memory_; }
 
  private:
   klu_common common_;
   klu_symbolic *symbolic_ = nullptr;
   klu_numeric *numeric_ = nullptr;
   int n_ = 0, analyses_ = 0;
+  bool out_of_memory_ = false;
 };
 
 }  // namespace

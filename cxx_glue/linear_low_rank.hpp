@@ -61,6 +61,7 @@ class LowRankSolver final : public DirectSolver {
   }
   long iterations() const override { return sparse_->iterations(); }
   int symbolic_count() const override { return sparse_->symbolic_count(); }
+  bool out_of_memory() const override { return sparse_->out_of_memory(); }
   bool overwrites_values() const override { return sparse_->overwrites_values(); }
   bool uses_blocks() const override { return sparse_->uses_blocks(); }
   void set_blocks(const int *block_of_row, int n_global) override {

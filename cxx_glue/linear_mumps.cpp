@@ -22,6 +22,7 @@
 #include <dmumps_c.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -118,6 +119,7 @@ class MumpsSolver final : public DirectSolver {
   }
 
   int symbolic_count() const override { return symbolic_; }
+  bool out_of_memory() const override { return out_of_memory_; }
 
  private:
   // The triplets (1-based rows and columns) of this rank's rows, kept for
@@ -172,21 +174,32 @@ class MumpsSolver final : public DirectSolver {
 
   // After a call: true (and why) when MUMPS reports an error. INFOG is
   // global: every rank sees the same.
-  bool failed(const char *phase, std::string &why) const {
+  bool failed(const char *phase, std::string &why) {
     const int info = id_.SP_INFOG(1);
+    out_of_memory_ = false;
     if (info >= 0) return false;
     why = std::string("MUMPS: ") + phase + " failed (INFOG(1) = " + std::to_string(info) +
           ", INFOG(2) = " + std::to_string(id_.SP_INFOG(2)) + ")";
     if (info == -10) why += ": the matrix is numerically singular";
-    if (info == -8 || info == -9 || info == -13 || info == -14 || info == -15)
-      why += ": out of workspace or memory";
+    if (info == -13) {
+      // An ALLOCATE refused: INFOG(2) entries (doubles), in millions when
+      // negative (the MUMPS users' guide, INFO(1) = -13).
+      const double entries = id_.SP_INFOG(2) < 0 ? -1e6 * id_.SP_INFOG(2) : id_.SP_INFOG(2);
+      char size[96];
+      snprintf(size, sizeof size, ": out of memory (it asked for %.3g entries, %.1f GB)", entries,
+               8 * entries / 1e9);
+      why += size;
+      out_of_memory_ = true;
+    }
+    if (info == -8 || info == -9 || info == -14 || info == -15)
+      why += ": out of workspace (internal)";
     return true;
   }
 
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   DMUMPS_STRUC_C id_;
-  bool started_ = false, analysed_ = false, factored_ = false;
+  bool started_ = false, analysed_ = false, factored_ = false, out_of_memory_ = false;
   int n_global_ = 0, n_rows_ = 0, symbolic_ = 0;
   std::vector<MUMPS_INT> irn_, jcn_;
   std::vector<int> counts_, firsts_;  // every rank's rows (several ranks)

@@ -37,6 +37,7 @@ class SuperLU final : public DirectSolver {
 
   bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
     release_factors();
+    out_of_memory_ = false;
     if (A.first_row != 0 || A.n_rows != A.n_global) {
       why = "SuperLU: the serial solver needs all rows on one process";
       return false;
@@ -66,10 +67,12 @@ class SuperLU final : public DirectSolver {
     Destroy_CompCol_Permuted(&AC);
     Destroy_SuperMatrix_Store(&At);
     have_factors_ = info <= n;  // info > n: allocation failure, no L/U
+    out_of_memory_ = info > n;
     if (info != 0) {
       why = info <= n ? "SuperLU: the matrix is singular (zero pivot in column " +
                             std::to_string(info) + ")"
-                      : "SuperLU: out of memory in the factorisation";
+                      : "SuperLU: out of memory in the factorisation (" +
+                            std::to_string((long)info - n) + " bytes held when an allocation failed)";
       release_factors();
       return false;
     }
@@ -100,6 +103,7 @@ class SuperLU final : public DirectSolver {
   }
 
   int symbolic_count() const override { return symbolic_; }
+  bool out_of_memory() const override { return out_of_memory_; }
 
  private:
   void release_factors() {
@@ -112,7 +116,7 @@ class SuperLU final : public DirectSolver {
   superlu_options_t options_;
   SuperLUStat_t stat_;
   SuperMatrix L_, U_;
-  bool have_factors_ = false;
+  bool have_factors_ = false, out_of_memory_ = false;
   int n_ = 0, symbolic_ = 0;
   std::vector<int> perm_c_, perm_r_, etree_;
 };

@@ -766,7 +766,16 @@ bool Solver::factor_jacobian(std::string &why) {
   }
   linear_->set_rhs_count(1);
   bool ok = linear_->factor(A, !pattern_changed_, why);
+  int oom = !ok && linear_->out_of_memory();
+  if (ok && sp_fault_due(SP_FAULT_FACTOR, rank_)) {  // (src/fault.h)
+    ok = false;
+    oom = 1;
+    why = "out of memory in the factorisation on rank " + std::to_string(rank_) +
+          " (fault injected by SOFTPACK_FAULT=factor:" + std::to_string(rank_) + ")";
+  }
   ok = all_agree(comm_, ok, why);
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &oom, 1, MPI_INT, MPI_MAX, comm_), "MPI_Allreduce");
+  linear_out_of_memory_ = !ok && oom;
   t_factor_ += now() - t0;
   if (!ok) {
     pattern_changed_ = true;  // start the next factorisation from scratch
@@ -805,6 +814,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   step_factorisations_ = 0;
   step_norms_.clear();
   linear_failure_.clear();
+  linear_out_of_memory_ = false;
   const double t_start = now();
   const long linear_its_before = linear_->iterations();
   Nox &n = *nox_;
@@ -870,7 +880,8 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
   // (the divergence test's status is this solve's: every test is checked at
   // the guess and after each iteration)
   report.failure = interrupted_ ? SP_NEWTON_INTERRUPTED
-                   : !linear_failure_.empty() ? SP_NEWTON_LINEAR_FAILED
+                   : !linear_failure_.empty()
+                       ? (linear_out_of_memory_ ? SP_NEWTON_OUT_OF_MEMORY : SP_NEWTON_LINEAR_FAILED)
                    : !std::isfinite(last) ? SP_NEWTON_NOT_FINITE
                    : !n.diverged.is_null() && n.diverged->getStatus() == Failed
                        ? SP_NEWTON_DIVERGED
@@ -882,7 +893,8 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
                              std::to_string(report.factorisations) + " factorisations)";
   std::string why;
   switch (report.failure) {
-    case SP_NEWTON_LINEAR_FAILED: why = linear_failure_; break;
+    case SP_NEWTON_LINEAR_FAILED:
+    case SP_NEWTON_OUT_OF_MEMORY: why = linear_failure_; break;
     case SP_NEWTON_NOT_FINITE: why = "the residual is not finite"; break;
     case SP_NEWTON_DIVERGED:
       why = "diverged: |F| above " + std::string(ratio) + " x the first |F| after " + counts;

@@ -110,6 +110,7 @@ class Solver {
   Teuchos::RCP<TpetraVector> apply_in_, apply_out_;
   // Why the current step's last linear solve failed (empty: none did).
   std::string linear_failure_;
+  bool linear_out_of_memory_ = false;  // the last factorisation failed for memory
   // Seconds of the current step: residual and Jacobian fills,
   // factorisations, solves (sp_step_report).
   double t_assembly_ = 0, t_factor_ = 0, t_solve_ = 0;

@@ -7,8 +7,8 @@
 
 #include "error.h"
 
-static const char *const phase_names[] = {"setup",    "solver", "step",     "output",
-                                          "assembly", "attach", "interrupt"};
+static const char *const phase_names[] = {"setup",  "solver",    "step",  "output", "assembly",
+                                          "attach", "interrupt", "factor"};
 #define N_PHASES (int)(sizeof phase_names / sizeof phase_names[0])
 
 /** What SOFTPACK_FAULT asks for: 0 and *phase, *rank, *kill (and for
@@ -66,7 +66,7 @@ int sp_fault_check(sp_fault_phase phase, int rank) {
   long step, attempt;
   if (phase == SP_FAULT_SETUP && fault_wanted(&p, &r, &kill, &step, &attempt) < 0)
     return sp_error_set(SP_ERR_INPUT, "SOFTPACK_FAULT: expected PHASE:RANK or PHASE:RANK:kill "
-                        "with PHASE setup, solver, step, output, assembly or attach, or "
+                        "with PHASE setup, solver, step, output, assembly, attach or factor, or "
                         "interrupt:RANK:STEP[:ATTEMPT] (STEP, ATTEMPT >= 1), got '%s'",
                         getenv("SOFTPACK_FAULT"));
   if (!sp_fault_due(phase, rank)) return SP_OK;

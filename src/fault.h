@@ -19,7 +19,10 @@
  *            fill's collective: a memory error on that rank, the other
  *            ranks told before the collective, cxx_glue/errors.hpp);
  *  - attach: where the glue takes a new layout (sp_solver_set_problem,
- *            before its node map's collective: a memory error, likewise).
+ *            before its node map's collective: a memory error, likewise);
+ *  - factor: each factorisation of the Jacobian on that rank reports
+ *            that it could not allocate its factors, as MUMPS's INFOG(1)
+ *            = -13 (the step is not retried: docs/robustness.md).
  * With ":kill" the rank sends itself SIGKILL there instead (not for
  * solver). And SOFTPACK_FAULT=interrupt:RANK:STEP[:ATTEMPT]: rank RANK is
  * asked to stop (as by SIGTERM) during step STEP, after the first Newton
@@ -43,7 +46,8 @@ typedef enum {
   SP_FAULT_OUTPUT = 3,
   SP_FAULT_ASSEMBLY = 4,
   SP_FAULT_ATTACH = 5,
-  SP_FAULT_INTERRUPT = 6
+  SP_FAULT_INTERRUPT = 6,
+  SP_FAULT_FACTOR = 7
 } sp_fault_phase;
 
 /** @brief 1 if SOFTPACK_FAULT asks @p rank to fail at @p phase (a ":kill"

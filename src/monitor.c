@@ -245,6 +245,15 @@ int sp_monitor_attempt(sp_run *run, const sp_step_attempt *a, int rc) {
   if (!a->give_up) return SP_OK;
   const int rc_out = write_snapshot(run);
   const sp_dt_params *p = &run->opt.time.dt;
+  if (a->verdict == SP_STEP_NEWTON_FAILED && a->report.failure == SP_NEWTON_OUT_OF_MEMORY)
+    return sp_error_set(SP_ERR_MEMORY,
+                        "step %d at t = %.6g: %s. A smaller step has a matrix of the same size, "
+                        "so it is not retried; solver.linear gmres_cells or gmres_ilu need less "
+                        "memory than a direct solver in 3D, and mumps or superlu_dist on more "
+                        "processes split the factors (docs/3d.md). The last good state "
+                        "(t = %.6g) is written%s.",
+                        run->step + 1, run->t, a->why, run->t,
+                        rc_out == SP_OK ? "" : " (failed: see above)");
   return sp_error_set(SP_ERR_SOLVER,
                       "step %d at t = %.6g failed %d attempts "
                       "(last dt = %.3g; time.max_retries = %d, time.dt_min = %.3g): %s. "

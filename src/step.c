@@ -127,6 +127,9 @@ static int judge(sp_run *run, sp_scheme_kind kind, int solved, sp_step_attempt *
   if (solved != 0) {
     a->verdict = SP_STEP_NEWTON_FAILED;
     a->give_up = sp_dt_newton_failed(&run->dtc, a->dt);
+    /* the factors did not fit in memory: a smaller step has a matrix of
+     * the same size and pattern, so retrying only repeats the failure */
+    if (a->report.failure == SP_NEWTON_OUT_OF_MEMORY) a->give_up = 1;
     return SP_OK;
   }
   if (sp_dt_judge(&run->dtc, a->dt, a->err) == SP_DT_REJECT) {

@@ -383,7 +383,8 @@ static int cmd_library(int argc, char **argv, int rank, int size) {
                {"step:1", SP_ERR_MEMORY},  {"output:1", SP_ERR_IO},
                {"step:0", SP_ERR_MEMORY},  {"output:0", SP_ERR_IO},
                {"assembly:1", SP_ERR_MEMORY}, {"assembly:0", SP_ERR_MEMORY},
-               {"attach:1", SP_ERR_MEMORY}, {"attach:0", SP_ERR_MEMORY}};
+               {"attach:1", SP_ERR_MEMORY}, {"attach:0", SP_ERR_MEMORY},
+               {"factor:1", SP_ERR_MEMORY}, {"factor:0", SP_ERR_MEMORY}};
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
     setenv("SOFTPACK_FAULT", cases[i].fault, 1);
     const double t0 = MPI_Wtime();

@@ -7,6 +7,8 @@
  *   (exit 1, "softpack: error (solver)"), not bad input;
  * - a failed allocation at set-up (SOFTPACK_FAULT=setup:0) is a memory
  *   error, exit 1; a malformed SOFTPACK_FAULT is bad input naming it;
+ * - a factorisation out of memory (SOFTPACK_FAULT=factor:0) ends the run
+ *   at its first attempt, a memory error, the last good state written;
  * - a layout whose Jacobian would overflow 32-bit offsets is refused (memory)
  *   before the glue sees it;
  * - bad input in the scene still exits 2. */
@@ -126,6 +128,24 @@ int main(int argc, char **argv) {
   CHECK(rc == SP_ERR_INPUT && strstr(sp_error_message(), "SOFTPACK_FAULT"),
         "malformed fault: rc %d: %s", rc, sp_error_message());
 
+  /* a factorisation that could not allocate its factors (as MUMPS's
+   * INFOG(1) = -13): a memory error at once, not retried with smaller
+   * steps (the same matrix's size), the last good state written */
+  system("rm -rf classes_factor");
+  sp_run_summary sum = {0};
+  setenv("SOFTPACK_FAULT", "factor:0", 1);
+  rc = sp_run_text("classes", scene, strlen(scene), 0, NULL, "classes_factor", MPI_COMM_WORLD,
+                   NULL, NULL, &sum);
+  unsetenv("SOFTPACK_FAULT");
+  printf("factor fault: %d after %d failed attempts, %s\n", rc, sum.failed_attempts,
+         sp_error_message());
+  CHECK(rc == SP_ERR_MEMORY && strstr(sp_error_message(), "SOFTPACK_FAULT=factor:0") &&
+            strstr(sp_error_message(), "not retried"),
+        "factor fault: rc %d: %s", rc, sp_error_message());
+  CHECK(sum.failed_attempts == 1 && sum.steps == 0, "factor fault: %d failed attempts, %d steps",
+        sum.failed_attempts, sum.steps);
+  CHECK(stat("classes_factor/fields_000000.vtu", &st) == 0, "the last good state is not written");
+
   /* the program: the class in the message, exit 1 unless bad input */
   char args[4096];
   snprintf(args, sizeof args, "run %s/tests/scenes/rectangle_full.yaml --out classes_cli",
@@ -134,6 +154,10 @@ int main(int argc, char **argv) {
                 "creation failed on rank 0");
   program_fails("setup:0", args, 1, "softpack: error (memory): out of memory");
   program_fails("step", args, 2, "softpack: error: SOFTPACK_FAULT: expected");
+  snprintf(args, sizeof args, "run %s/tests/scenes/rectangle_full.yaml --out classes_cli_factor",
+           SP_SOURCE_DIR);
+  program_fails("factor:0", args, 1, "softpack: error (memory): step 1 at t = 0: out of memory "
+                "in the factorisation");
   snprintf(args, sizeof args,
            "run %s/tests/scenes/rectangle_full.yaml --out classes_cli --set time.dt=-1",
            SP_SOURCE_DIR);
