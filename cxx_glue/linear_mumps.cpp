@@ -14,8 +14,10 @@
 // (PAR = 1), automatic column permutation and ordering (ICNTL(6) = ICNTL(7)
 // = 7), row and column iterative scaling (ICNTL(8) = 7, what Amesos sets),
 // no iterative refinement, workspace relaxation 100% (ICNTL(14): delayed
-// pivots need room), the pivoting threshold CNTL(1) = 0.01 (MUMPS'
-// default for unsymmetric matrices). Unlike Amesos, which ends the process
+// pivots need room; 20% from the first factorisation whose workspace
+// could not be allocated with 100%: docs/3d.md, "Refinements 5"), the
+// pivoting threshold CNTL(1) = 0.01 (MUMPS' default for unsymmetric
+// matrices). Unlike Amesos, which ends the process
 // on any MUMPS error, a failed factorisation or solve returns false with
 // MUMPS' INFOG(1), INFOG(2) in why, so Newton fails the attempt and the
 // step is retried.
@@ -37,6 +39,7 @@ namespace {
 #define SP_INFOG(I) infog[(I) - 1]
 
 constexpr int kJobInit = -1, kJobEnd = -2, kJobAnalyse = 1, kJobFactor = 2, kJobSolve = 3;
+constexpr int kLeanRelaxation = 20;  // ICNTL(14) as MUMPS itself sets it (unsymmetric, one process)
 
 class MumpsSolver final : public DirectSolver {
  public:
@@ -89,6 +92,15 @@ class MumpsSolver final : public DirectSolver {
     else id_.a_loc = A.val;
     id_.job = kJobFactor;
     dmumps_c(&id_);
+    if (id_.SP_INFOG(1) == -13 && relaxation_ > kLeanRelaxation) {
+      // The workspace MUMPS allocates is its analysis's estimate plus
+      // ICNTL(14) percent; a refused allocation with 100% may fit with
+      // what MUMPS itself sets, 20% (room for fewer delayed pivots): once
+      // more with that, and with it from now on.
+      relaxation_ = kLeanRelaxation;
+      id_.SP_ICNTL(14) = relaxation_;
+      dmumps_c(&id_);
+    }
     if (failed("numeric factorisation", why)) return false;
     factored_ = true;
     return true;
@@ -165,7 +177,7 @@ class MumpsSolver final : public DirectSolver {
     id_.SP_ICNTL(9) = 1;  // A x = b
     id_.SP_ICNTL(10) = 0;  // no iterative refinement
     id_.SP_ICNTL(11) = 0;  // no error analysis
-    id_.SP_ICNTL(14) = 100;  // workspace relaxation, %
+    id_.SP_ICNTL(14) = relaxation_;  // workspace relaxation, % (100, or 20 once 100 did not fit)
     id_.SP_ICNTL(18) = size_ == 1 ? 0 : 3;  // centralised / distributed input
     id_.SP_ICNTL(20) = 0;  // dense right-hand side ...
     id_.SP_ICNTL(21) = 0;  // ... and solution, on the host
@@ -201,6 +213,7 @@ class MumpsSolver final : public DirectSolver {
   DMUMPS_STRUC_C id_;
   bool started_ = false, analysed_ = false, factored_ = false, out_of_memory_ = false;
   int n_global_ = 0, n_rows_ = 0, symbolic_ = 0;
+  int relaxation_ = 100;  // ICNTL(14)
   std::vector<MUMPS_INT> irn_, jcn_;
   std::vector<int> counts_, firsts_;  // every rank's rows (several ranks)
   std::vector<double> rhs_;           // the gathered right-hand side (rank 0)
