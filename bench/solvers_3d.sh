@@ -97,7 +97,11 @@ for case in "${cases[@]}"; do
          awk -v cap="$time_s" '{ exit !($1 >= 0.95 * cap) }' <<< "${cpu_max:-0}"; then
       result="stopped: CPU time > ${time_s} s"
     elif [ "$status" -ne 0 ] && grep -qiE 'memory|alloc' "$out/$run.log"; then
-      result="stopped: memory > ${mem_gb} GB ($(grep -iE 'memory|alloc' "$out/$run.log" | tail -1 |
+      # MUMPS says what it asked for (linear_mumps.cpp); else the last such line
+      asked=$(grep -o 'INFOG(1) = -13, INFOG(2) = -*[0-9]*): out of memory (it asked for [^)]*)' \
+        "$out/$run.log" | tail -1 | sed 's/): out of memory (/: /; s/)$//')
+      result="stopped: memory > ${mem_gb} GB ($([ -n "$asked" ] && echo "MUMPS $asked" ||
+        grep -iE 'memory|alloc' "$out/$run.log" | tail -1 |
         sed 's/.*(time.max_retries[^)]*): //' | cut -c1-100))"
     elif [ "$status" -ne 0 ]; then
       result="failed: exit $status ($(grep -v '^---' "$out/$run.log" | tail -1 | cut -c1-100))"
