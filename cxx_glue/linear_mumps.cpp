@@ -20,7 +20,8 @@
 // matrices). Unlike Amesos, which ends the process
 // on any MUMPS error, a failed factorisation or solve returns false with
 // MUMPS' INFOG(1), INFOG(2) in why, so Newton fails the attempt and the
-// step is retried.
+// step is retried (but for a refused allocation, INFOG(1) = -13:
+// out_of_memory(), and the run ends, docs/robustness.md).
 #include <dmumps_c.h>
 
 #include <algorithm>
