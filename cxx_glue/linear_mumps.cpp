@@ -199,8 +199,9 @@ class MumpsSolver final : public DirectSolver {
       // negative (the MUMPS users' guide, INFO(1) = -13).
       const double entries = id_.SP_INFOG(2) < 0 ? -1e6 * id_.SP_INFOG(2) : id_.SP_INFOG(2);
       char size[96];
-      snprintf(size, sizeof size, ": out of memory (it asked for %.3g entries, %.1f GB)", entries,
-               8 * entries / 1e9);
+      const double bytes = 8 * entries;
+      snprintf(size, sizeof size, ": out of memory (it asked for %.3g entries, %.1f %s)", entries,
+               bytes >= 1e9 ? bytes / 1e9 : bytes / 1e6, bytes >= 1e9 ? "GB" : "MB");
       why += size;
       out_of_memory_ = true;
     }
