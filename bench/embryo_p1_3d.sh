@@ -7,7 +7,8 @@
 # min); bench/embryo_table.py's 4-cell stage (volumes, contacts, centres,
 # gaps) for each. About 70 s a run on one process.
 # SEMI_Y=s: the shell's y and z semi-axes s (the scene's 0.3: 30 um; the
-# coverslip's |z| <= 0.25 stays) with P0's y semi-axis scaled by s / 0.3;
+# coverslip's |z| <= 0.25 stays, but for s <= 0.25, not cut) with P0's y
+# semi-axis scaled by s / 0.3;
 # AB=A: AB's cut along the fixed normal (cos A, sin A, 0), A degrees from
 # the egg's axis (90: across it, in the coverslip's plane), in place of
 # the scene's perpendicular rule.
@@ -29,8 +30,12 @@ print(f'direction_x: {math.cos(a):.6f}, direction_y: {math.sin(a):.6f}, directio
 }
 tag=${semi:+s${semi}_}${ab:+ab${ab}_}
 extra=()
-[ -n "$semi" ] && extra+=(--set mesh.semi_y="$semi" --set mesh.semi_z="$semi")
-[ -n "$semi$ab" ] && echo "shell semi_y = semi_z = ${semi:-0.3}; AB's cut: ${ab:+fixed at $ab degrees}${ab:-perpendicular}"
+# (a shell no taller than the coverslip's 0.25 is not cut: flatten 0)
+[ -n "$semi" ] && extra+=(--set mesh.semi_y="$semi" --set mesh.semi_z="$semi"
+  --set mesh.flatten="$(python3 -c "print(0.25 if $semi > 0.25 else 0)")")
+ab_rule=perpendicular
+[ -n "$ab" ] && ab_rule="fixed at $ab degrees"
+[ -n "$semi$ab" ] && echo "shell semi_y = semi_z = ${semi:-0.3}; AB's cut: $ab_rule"
 for b in "${angles[@]}"; do
   name=${tag}p1_$b
   p1=$(normal "$b")
