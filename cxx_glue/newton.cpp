@@ -774,7 +774,9 @@ bool Solver::factor_jacobian(std::string &why) {
           " (fault injected by SOFTPACK_FAULT=factor:" + std::to_string(rank_) + ")";
   }
   ok = all_agree(comm_, ok, why);
-  check_mpi(MPI_Allreduce(MPI_IN_PLACE, &oom, 1, MPI_INT, MPI_MAX, comm_), "MPI_Allreduce");
+  // (ok is agreed now: the ranks reduce the memory flag only after a failure)
+  if (!ok)
+    check_mpi(MPI_Allreduce(MPI_IN_PLACE, &oom, 1, MPI_INT, MPI_MAX, comm_), "MPI_Allreduce");
   linear_out_of_memory_ = !ok && oom;
   t_factor_ += now() - t0;
   if (!ok) {

@@ -24,7 +24,7 @@ run() { # run NAME [VAR=value ...]: the scene's first two steps with MUMPS
     --set solver.linear=mumps --set output.pictures=false --set time.max_steps=2 \
     > "$out/$name.log" 2>&1
 }
-no_clock() { cut -d, -f1-11,17- "$1"; } # energy.csv without seconds .. supports_s
+strip_clock="$(dirname "$0")/../tools/strip_clock.sh" # energy.csv without the wall-clock columns
 
 run free SP_MALLOC_REPORT=1 || fail "the run without a cap: $(tail -3 "$out/free.log")"
 read -r largest next < <(sed -n 's/^malloc_cap: softpack largest \([0-9]*\) next \([0-9]*\)$/\1 \2/p' "$out/free.log")
@@ -36,7 +36,7 @@ echo "largest allocation $largest bytes (MUMPS's workspace at 100%), next $next"
 run lean SP_MALLOC_CAP=$((largest * 8 / 10))
 status=$?
 [ "$status" -eq 0 ] || fail "capped at 0.8 x $largest: exit $status: $(tail -3 "$out/lean.log")"
-cmp <(no_clock "$out/free/energy.csv") <(no_clock "$out/lean/energy.csv") ||
+cmp <("$strip_clock" "$out/free/energy.csv") <("$strip_clock" "$out/lean/energy.csv") ||
   fail "capped at 0.8 x: energy.csv differs from the run without a cap"
 cmp "$out/free/cells.csv" "$out/lean/cells.csv" ||
   fail "capped at 0.8 x: cells.csv differs from the run without a cap"

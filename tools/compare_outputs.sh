@@ -73,12 +73,7 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/softpack_compare.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
 # energy.csv without the wall-clock columns
-strip_clock() {
-  awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i)
-                       if ($i ~ /^(seconds|assembly_s|factorisation_s|solves_s|supports_s)$/) drop[i] = 1 }
-           { out = ""; for (i = 1; i <= NF; ++i) if (!(i in drop)) out = out (out == "" ? "" : ",") $i
-             print out }' "$1"
-}
+strip_clock() { tools/strip_clock.sh "$1"; }
 
 run_one() { # BINARY NP SCENE DIR
   local sp=$1 np=$2 scene=$3 dir=$4 launch=()
