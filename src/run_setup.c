@@ -100,7 +100,10 @@ static int maybe_local_supports(sp_run *run, const sp_scene *scene, int n_cells)
                                                             : SP_SUPPORT_FILL_EDGE,
                           .restore = ly->restore == SP_RESTORE_POTENTIAL
                                          ? SP_SUPPORT_RESTORE_POTENTIAL
-                                         : SP_SUPPORT_RESTORE_INTERIOR};
+                                         : SP_SUPPORT_RESTORE_INTERIOR,
+                          .buffer = ly->buffer_elements == SP_BUFFER_ELEMENTS_WHOLE
+                                        ? SP_SUPPORT_BUFFER_WHOLE
+                                        : SP_SUPPORT_BUFFER_MARGIN};
   return sp_support_create(run->mesh, &sp, &run->support);
 }
 

@@ -199,6 +199,8 @@ static const cyaml_strval_t sp_fill_words[] = {{"edge", SP_FILL_EDGE},
                                                   {"relax", SP_FILL_RELAX}};
 static const cyaml_strval_t sp_restore_words[] = {{"interior", SP_RESTORE_INTERIOR},
                                                      {"potential", SP_RESTORE_POTENTIAL}};
+static const cyaml_strval_t sp_buffer_elements_words[] = {
+    {"margin", SP_BUFFER_ELEMENTS_MARGIN}, {"whole", SP_BUFFER_ELEMENTS_WHOLE}};
 static const cyaml_strval_t sp_axis_words[] = {
     {"long", SP_AXIS_LONG}, {"fixed", SP_AXIS_FIXED}, {"perpendicular", SP_AXIS_PERPENDICULAR}};
 static const cyaml_strval_t sp_indicator_words[] = {
@@ -603,6 +605,13 @@ static const sp_key sp_keys[] = {
              "field's response to one rise of the chemical potential over "
              "the whole support, held down inside neighbours and the buffer "
              "ring (potential: smooth, docs/local-support.md)"),
+    KEY_ENUM(SP_SEC_LAYOUT, "buffer_elements", layout.buffer_elements,
+             SP_BUFFER_ELEMENTS_WHOLE, sp_buffer_elements_words, "-",
+             "local: a support that reaches the buffer ring takes every "
+             "buffer element it touches whole, so no node of its edge sits "
+             "beside the ring unheld (whole: far smaller energy rises at a "
+             "change in the eggshell, docs/local-support.md), or the "
+             "elements within the margin alone (margin: the published runs)"),
     /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
      * in E L^2, so delta is in E / L^6 (3D: L^5, E L^3, E / L^7) */
     KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),

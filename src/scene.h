@@ -259,6 +259,9 @@ typedef enum { SP_FILL_EDGE = 0, SP_FILL_RELAX = 1 } sp_fill_kind;
 /** Where a support change restores each cell's mass. */
 typedef enum { SP_RESTORE_INTERIOR = 0, SP_RESTORE_POTENTIAL = 1 } sp_restore_kind;
 
+/** Which buffer-ring elements a local support takes. */
+typedef enum { SP_BUFFER_ELEMENTS_MARGIN = 0, SP_BUFFER_ELEMENTS_WHOLE = 1 } sp_buffer_elements_kind;
+
 /** layout: where each cell's field lives. */
 typedef struct {
   sp_support_kind support; /**< auto | full (the paper) | local */
@@ -270,6 +273,8 @@ typedef struct {
                                 only the supports of dividing cells */
   sp_fill_kind fill;       /**< local: what new pairs of a change start from */
   sp_restore_kind restore; /**< local: where a change restores the masses */
+  sp_buffer_elements_kind buffer_elements; /**< local: the buffer ring's elements a
+                                                support touches: whole, or by margin */
 } sp_scene_layout;
 
 /** How the shape term enters a step (src/shape.h). */

@@ -237,6 +237,39 @@ static int widen_by_layers(sp_support s, int k, int layers, cell_lists *L) {
   return rc;
 }
 
+/**
+ * layout.buffer_elements = whole: cell k's support, L's last list (closed
+ * to whole elements), takes every buffer element one of its nodes touches,
+ * whole (one pass: the nodes this adds are not taken further). A node of
+ * the support's edge then never sits beside a buffer element the cell does
+ * not count: beside one it is a node of a whole buffer element, held down
+ * by the ring's term. With the margin alone an edge node between a free
+ * element and an uncounted buffer element sits at the free far-field
+ * level, and when that element becomes whole at the next change its
+ * buffer energy appears at once (the eggshell's term jumping 3-5x at a
+ * change in the 3D run 5: docs/local-support.md). Costs the support's
+ * elements.
+ */
+static int take_buffer_elements(sp_support s, int k, cell_lists *L) {
+  const sp_mesh *m = s->mesh;
+  if (s->params.buffer != SP_SUPPORT_BUFFER_WHOLE || !m->region) return SP_OK;
+  const int64_t j0 = L->start[k], j1 = L->start[k + 1];
+  int rc = SP_OK;
+  for (int64_t j = j0; j < j1; ++j) s->member[L->node[j]] = 1;
+  for (int64_t j = j0; j < j1 && rc == SP_OK; ++j)
+    for (int t = s->ne_start[L->node[j]]; t < s->ne_start[L->node[j] + 1] && rc == SP_OK; ++t) {
+      if (m->region[s->ne_list[t]] != SP_REGION_BUFFER) continue;
+      const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
+      for (int a = 0; a < m->nodes_per_elem && rc == SP_OK; ++a)
+        if (!s->member[nodes[a]]) {
+          s->member[nodes[a]] = 1;
+          rc = lists_push(L, k, nodes[a]);
+        }
+    }
+  for (int64_t j = j0; j < L->start[k + 1]; ++j) s->member[L->node[j]] = 0;
+  return rc;
+}
+
 static void lists_free(cell_lists *L) {
   free(L->start);
   free(L->node);
@@ -268,6 +301,7 @@ int sp_support_layout_from_masks(sp_support s, int n_cells, unsigned char *mask,
     for (int i = 0; i < nn; ++i)
       if (mk[i]) s->queue[n++] = i;
     rc = close_to_elements(s, mark_members(s, n), k, &L);
+    if (rc == SP_OK) rc = take_buffer_elements(s, k, &L);
     /* the mask closed, as the caller may read it */
     memset(mk, 0, (size_t)nn);
     for (int64_t j = L.start[k]; j < L.start[k + 1] && rc == SP_OK; ++j) mk[L.node[j]] = 1;
@@ -297,6 +331,9 @@ static int widened_layout(sp_support s, const sp_layout *layout, const double *s
         }
     rc = close_to_elements(s, n, k, &L);
     if (rc == SP_OK && layers && layers[k] > 0) rc = widen_by_layers(s, k, layers[k], &L);
+    /* after the widening, whose last layer would otherwise end beside
+     * the ring */
+    if (rc == SP_OK) rc = take_buffer_elements(s, k, &L);
   }
   if (rc == SP_OK) rc = sp_layout_create_from_lists(layout->n_nodes, nc, L.start, L.node, out);
   lists_free(&L);

@@ -15,7 +15,9 @@
  * restored exactly by one shift of its chemical potential over its whole
  * support (layout.restore = potential) or a uniform shift of c_k over its
  * interior c_k >= 1/2 (interior). The mass changes that shift corrects are
- * reported.
+ * reported. With layout.buffer_elements = whole a support takes every
+ * buffer-ring element one of its nodes touches, whole, so no edge node
+ * sits beside the ring unheld by its term.
  */
 #ifndef SP_SUPPORT_H
 #define SP_SUPPORT_H
@@ -42,6 +44,12 @@ typedef enum {
   SP_SUPPORT_RESTORE_POTENTIAL = 1 /**< delta x 2 alpha / (the node's stiffness), everywhere */
 } sp_support_restore_kind;
 
+/** Which buffer-ring elements a support takes (layout.buffer_elements). */
+typedef enum {
+  SP_SUPPORT_BUFFER_MARGIN = 0, /**< those the margin closes to whole elements */
+  SP_SUPPORT_BUFFER_WHOLE = 1   /**< also every buffer element one of its nodes touches */
+} sp_support_buffer_kind;
+
 /** Parameters (lengths in the model's length unit). */
 typedef struct {
   double margin;         /**< support = elements within this of the core */
@@ -53,6 +61,7 @@ typedef struct {
   double alpha, kappa, lambda, lambda_b;
   sp_support_fill_kind fill; /**< layout.fill */
   sp_support_restore_kind restore; /**< layout.restore */
+  sp_support_buffer_kind buffer;   /**< layout.buffer_elements */
 } sp_support_params;
 
 /** @brief Node adjacency of a mesh and the parameters. */

@@ -27,6 +27,10 @@
  *    = 0.044), not with margin 12 d nor at refinements 4; sp_support_rebuild
  *    gives supports that do not in all three, widened where the computed
  *    ones would (more nodes) and as computed where not (the same nodes);
+ *  - layout.buffer_elements: with whole, no node of a support sits beside
+ *    a buffer element the cell does not count unless it is in one it
+ *    counts (by the margin alone some do), at the set-up and after a
+ *    rebuild; whole keeps the margin's support and adds to it;
  *  - the 3D run 5 (inputs/3d/embryo_8.yaml) at refinements 3 to t = 0.001:
  *    supports that changed at every step (187 steps) change, and no two
  *    consecutive steps both change them; each cell's mass is conserved to
@@ -320,6 +324,99 @@ static void test_coarse_rule(void) {
   }
 }
 
+/** Nodes of cell k's support beside the buffer ring and unheld by it: a
+ *  node of a buffer element the cell does not count (not whole for it)
+ *  and of no buffer element it counts. */
+static int unheld_beside_ring(const sp_mesh *mesh, const sp_layout *layout, int k) {
+  const int nn = mesh->n_nodes, nen = mesh->nodes_per_elem;
+  unsigned char *held = calloc((size_t)nn, 1), *beside = calloc((size_t)nn, 1);
+  for (int e = 0; e < mesh->n_elems; ++e) {
+    if (mesh->region[e] != SP_REGION_BUFFER) continue;
+    const int *nodes = sp_mesh_elem_nodes(mesh, e);
+    int whole = 1;
+    for (int a = 0; a < nen; ++a) whole &= sp_layout_pair(layout, k, nodes[a]) >= 0;
+    for (int a = 0; a < nen; ++a)
+      if (sp_layout_pair(layout, k, nodes[a]) >= 0) (whole ? held : beside)[nodes[a]] = 1;
+  }
+  int n = 0;
+  for (int i = 0; i < nn; ++i) n += beside[i] && !held[i];
+  free(held);
+  free(beside);
+  return n;
+}
+
+/* layout.buffer_elements (docs/local-support.md, "The buffer ring's
+ * elements"): a tanh sphere of radius 0.2 at (0.22, 0, 0) in the 3D run
+ * 5's ellipsoid at refinements 4, its support reaching the eggshell's
+ * ring. By the margin alone the support has edge nodes beside ring
+ * elements it does not count and in none it counts (their far field sits
+ * at the free level until those elements become whole at a change); with
+ * whole, none, at the set-up and after a rebuild, the margin's support is
+ * kept (whole only adds nodes), and the rebuild keeps the mass. */
+static void test_buffer_elements(void) {
+  sp_mesh *mesh;
+  CHECK_OK(sp_mesh_ellipsoid(4, 0.5, 0.25, 0.25, 2, 0.1, &mesh));
+  if (sp_test_failures) return;
+  const int nn = mesh->n_nodes;
+  const double kappa = 1e-3, alpha = 4, d = sqrt(kappa / (2 * alpha));
+  sp_layout *full;
+  CHECK_OK(sp_layout_create_full(nn, 1, &full));
+  double *state = calloc(2 * (size_t)nn, sizeof(double));
+  for (int i = 0; i < nn; ++i) {
+    const double *x = mesh->xy + 3 * i;
+    const double r = sqrt((x[0] - 0.22) * (x[0] - 0.22) + x[1] * x[1] + x[2] * x[2]);
+    state[2 * i] = 1 / (1 + exp((r - 0.2) / d));
+  }
+  sp_support_params p = {.margin = 8 * d, .core_threshold = 0.1, .grow_threshold = 0.2,
+                         .band = 4 * d, .alpha = alpha, .kappa = kappa, .lambda = 100,
+                         .lambda_b = 100, .fill = SP_SUPPORT_FILL_RELAX,
+                         .restore = SP_SUPPORT_RESTORE_POTENTIAL};
+  sp_layout *initial[2];
+  double *cut[2];
+  int unheld[2];
+  for (int w = 0; w < 2; ++w) {
+    p.buffer = w ? SP_SUPPORT_BUFFER_WHOLE : SP_SUPPORT_BUFFER_MARGIN;
+    sp_support s;
+    CHECK_OK(sp_support_create(mesh, &p, &s));
+    CHECK_OK(sp_support_initial(s, full, state, &initial[w], &cut[w]));
+    unheld[w] = unheld_beside_ring(mesh, initial[w], 0);
+    sp_support_destroy(&s);
+  }
+  int kept = 1;
+  for (int i = 0; i < nn; ++i)
+    if (sp_layout_pair(initial[0], 0, i) >= 0) kept &= sp_layout_pair(initial[1], 0, i) >= 0;
+  /* a rebuild of the margin's supports with whole */
+  sp_support s;
+  sp_layout *rebuilt;
+  double *next, correction, dropped;
+  CHECK_OK(sp_support_create(mesh, &p, &s));
+  CHECK_OK(sp_support_rebuild(s, initial[0], cut[0], NULL, &rebuilt, &next, &correction,
+                              &dropped));
+  const int unheld_rebuilt = unheld_beside_ring(mesh, rebuilt, 0);
+  printf("buffer elements: set-up %d nodes by the margin (%d beside the ring unheld), %d "
+         "whole (%d); rebuilt with whole %d nodes (%d), mass dropped %.2e\n",
+         initial[0]->n_pairs, unheld[0], initial[1]->n_pairs, unheld[1], rebuilt->n_pairs,
+         unheld_rebuilt, dropped);
+  CHECK(unheld[0] > 0, "by the margin no edge node sits beside the ring unheld: nothing tested");
+  CHECK(unheld[1] == 0 && unheld_rebuilt == 0,
+        "whole: %d nodes beside the ring unheld at the set-up, %d after a rebuild", unheld[1],
+        unheld_rebuilt);
+  CHECK(kept && initial[1]->n_pairs > initial[0]->n_pairs,
+        "whole does not keep the margin's support (%d against %d nodes)", initial[1]->n_pairs,
+        initial[0]->n_pairs);
+  CHECK(dropped <= 1e-13, "the rebuild dropped %.3g of the mass", dropped);
+  for (int w = 0; w < 2; ++w) {
+    free(cut[w]);
+    sp_layout_destroy(&initial[w]);
+  }
+  free(next);
+  free(state);
+  sp_layout_destroy(&rebuilt);
+  sp_layout_destroy(&full);
+  sp_support_destroy(&s);
+  sp_mesh_destroy(&mesh);
+}
+
 /* The 3D run 5 at refinements 3 to t = 0.001 (the zygote alone): its
  * supports, computed on elements wider than margin - band, changed at
  * every step (187 steps, docs/3d.md); now the set-up's supports are
@@ -367,6 +464,7 @@ static void test_coarse_run(void) {
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   test_coarse_rule();
+  test_buffer_elements();
   test_coarse_run();
   test_auto();
   test_laws();
