@@ -211,29 +211,44 @@ static int close_to_elements(sp_support s, int n, int k, cell_lists *L) {
   return rc;
 }
 
+/** Mark (@p on 1) or unmark (0) cell k's list in @p L in s->member. */
+static void mark_list(sp_support s, int k, const cell_lists *L, unsigned char on) {
+  for (int64_t j = L->start[k]; j < L->start[k + 1]; ++j) s->member[L->node[j]] = on;
+}
+
+/**
+ * Append to cell k's list (L's last, its nodes marked in s->member) every
+ * node not yet in it of the elements around its nodes up to @p j1 (only
+ * buffer-ring elements with @p buffer_only): a layer of whole elements.
+ */
+static int add_touching_elements(sp_support s, int k, int64_t j1, int buffer_only,
+                                 cell_lists *L) {
+  const sp_mesh *m = s->mesh;
+  int rc = SP_OK;
+  for (int64_t j = L->start[k]; j < j1 && rc == SP_OK; ++j)
+    for (int t = s->ne_start[L->node[j]]; t < s->ne_start[L->node[j] + 1] && rc == SP_OK; ++t) {
+      if (buffer_only && m->region[s->ne_list[t]] != SP_REGION_BUFFER) continue;
+      const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
+      for (int a = 0; a < m->nodes_per_elem && rc == SP_OK; ++a)
+        if (!s->member[nodes[a]]) {
+          s->member[nodes[a]] = 1;
+          rc = lists_push(L, k, nodes[a]);
+        }
+    }
+  return rc;
+}
+
 /**
  * Widen cell k's support, L's last list (closed to whole elements), by
  * @p layers layers of elements: each layer adds every element touching it
  * (so the list stays closed). Costs the elements around the support.
  */
 static int widen_by_layers(sp_support s, int k, int layers, cell_lists *L) {
-  const sp_mesh *m = s->mesh;
-  const int64_t j0 = L->start[k];
   int rc = SP_OK;
-  for (int64_t j = j0; j < L->start[k + 1]; ++j) s->member[L->node[j]] = 1;
-  for (int layer = 0; layer < layers && rc == SP_OK; ++layer) {
-    const int64_t j1 = L->start[k + 1]; /* the support the layer goes around */
-    for (int64_t j = j0; j < j1 && rc == SP_OK; ++j)
-      for (int t = s->ne_start[L->node[j]]; t < s->ne_start[L->node[j] + 1] && rc == SP_OK; ++t) {
-        const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
-        for (int a = 0; a < m->nodes_per_elem && rc == SP_OK; ++a)
-          if (!s->member[nodes[a]]) {
-            s->member[nodes[a]] = 1;
-            rc = lists_push(L, k, nodes[a]);
-          }
-      }
-  }
-  for (int64_t j = j0; j < L->start[k + 1]; ++j) s->member[L->node[j]] = 0;
+  mark_list(s, k, L, 1);
+  for (int layer = 0; layer < layers && rc == SP_OK; ++layer)
+    rc = add_touching_elements(s, k, L->start[k + 1], 0, L); /* around the support so far */
+  mark_list(s, k, L, 0);
   return rc;
 }
 
@@ -251,22 +266,10 @@ static int widen_by_layers(sp_support s, int k, int layers, cell_lists *L) {
  * elements.
  */
 static int take_buffer_elements(sp_support s, int k, cell_lists *L) {
-  const sp_mesh *m = s->mesh;
-  if (s->params.buffer != SP_SUPPORT_BUFFER_WHOLE || !m->region) return SP_OK;
-  const int64_t j0 = L->start[k], j1 = L->start[k + 1];
-  int rc = SP_OK;
-  for (int64_t j = j0; j < j1; ++j) s->member[L->node[j]] = 1;
-  for (int64_t j = j0; j < j1 && rc == SP_OK; ++j)
-    for (int t = s->ne_start[L->node[j]]; t < s->ne_start[L->node[j] + 1] && rc == SP_OK; ++t) {
-      if (m->region[s->ne_list[t]] != SP_REGION_BUFFER) continue;
-      const int *nodes = sp_mesh_elem_nodes(m, s->ne_list[t]);
-      for (int a = 0; a < m->nodes_per_elem && rc == SP_OK; ++a)
-        if (!s->member[nodes[a]]) {
-          s->member[nodes[a]] = 1;
-          rc = lists_push(L, k, nodes[a]);
-        }
-    }
-  for (int64_t j = j0; j < L->start[k + 1]; ++j) s->member[L->node[j]] = 0;
+  if (s->params.buffer != SP_SUPPORT_BUFFER_WHOLE || !s->mesh->region) return SP_OK;
+  mark_list(s, k, L, 1);
+  const int rc = add_touching_elements(s, k, L->start[k + 1], 1, L);
+  mark_list(s, k, L, 0);
   return rc;
 }
 
