@@ -25,14 +25,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
-#include "division.h"
-#include "error.h"
-#include "initial.h"
-#include "layout.h"
-#include "mesh.h"
-#include "scene.h"
-#include "stepper.h"
+#include "model/cells.h"
+#include "model/division.h"
+#include "public/error.h"
+#include "io/initial.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 /** The scene's text without its cells, starting from @p vtu instead. */
 static char *scene_from_vtu(const char *scene_path, const char *vtu) {

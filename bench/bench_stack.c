@@ -17,14 +17,14 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "cells.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
-#include "q1.h"
+#include "model/cells.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 #include "softpack_solver.h"
-#include "resize.h"
-#include "stepper.h"
+#include "run/resize.h"
+#include "run/stepper.h"
 
 #define N_CELLS 3
 

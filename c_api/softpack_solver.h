@@ -6,7 +6,7 @@
  * catches every exception and returns a code (sp_solver_status: the class of
  * the error); the message is kept in the handle (sp_solver_last_error).
  *
- * The unknowns follow a layout (src/layout.h): pairs (cell, node), numbered
+ * The unknowns follow a layout (src/mesh/layout.h): pairs (cell, node), numbered
  * node-major, two unknowns per pair: state[2p] = c, state[2p+1] = mu.
  */
 #ifndef SOFTPACK_SOLVER_H
@@ -24,7 +24,7 @@ extern "C" {
 /**
  * What every entry point returns: 0, Newton's failure to converge
  * (sp_solver_step only: retry with a smaller dt), or the class of a hard
- * error. The C core maps the classes to its own codes (src/solver_status.h)
+ * error. The C core maps the classes to its own codes (src/run/solver_status.h)
  * and so to exit statuses: only SP_SOLVER_ERR_INPUT is bad input (exit 2),
  * every other class exits 1 (docs/robustness.md).
  */
@@ -112,7 +112,7 @@ typedef struct {
 
 /** The mesh, borrowed (must outlive the solver's use of it): Q1
  *  quadrilaterals (dim 2, 4 nodes per element) or hexahedra (dim 3, 8),
- *  nodes in the order of src/q1.h. */
+ *  nodes in the order of src/mesh/q1.h. */
 typedef struct {
   int n_nodes, n_elems;
   const double *xy;       /**< dim * n_nodes */
@@ -132,7 +132,7 @@ typedef struct {
    *  communicator size). NULL: equal node counts per rank. */
   const int *rank_first_node;
   int n_ranks;
-  /** The element-slot table (src/layout.h, sp_slots; required): element
+  /** The element-slot table (src/mesh/layout.h, sp_slots; required): element
    *  e's cells are slot_cell[elem_start[e] .. elem_start[e+1]-1], by
    *  increasing cell, each with the pairs of the element's nodes at
    *  slot_pair[n s .. n s + n - 1], n = the mesh's nodes_per_elem. The C
@@ -153,7 +153,7 @@ typedef struct {
  * Shape-penalty data of one cell (MODEL.md, shape penalty): the term adds
  * -sum_i coef_i * (v_i . Ibar(X) v_i) to mu_k, Ibar about the centre (xc,
  * yc[, zc]), i over the mesh's dim principal moments (2 in 2D, 3 in 3D;
- * Ibar = |Xb|^2 Id - Xb Xb^T, src/shape.h). Entries beyond dim are unused.
+ * Ibar = |Xb|^2 Id - Xb Xb^T, src/model/shape.h). Entries beyond dim are unused.
  *
  * Explicit (sp_step_data.shape_implicit = 0): coef as given, from c^n.
  * Linearised implicit (shape_implicit = 1): with the centre, eigenvectors
@@ -168,7 +168,7 @@ typedef struct {
   double xc, yc;
   double zc;       /**< 3D: the centre's z (0 in 2D) */
   double v[3][3];  /**< unit eigenvectors v_1 (largest moment), v_2 (, v_3) */
-  double coef[3];  /**< 2 delta^i (I^i,ref - I^i) (round cells: src/shape.h) */
+  double coef[3];  /**< 2 delta^i (I^i,ref - I^i) (round cells: src/model/shape.h) */
   double gain[3][3]; /**< -d coef_i / d I_j (implicit only; 0: none) */
   double threshold; /**< the term acts only where c^n >= threshold (at the
                          quadrature point), as the observables count c only

@@ -7,9 +7,9 @@
 
 #include <Trilinos_version.h>
 
-#include "errors.hpp"
-#include "fault.h"
-#include "linear.hpp"
+#include "base/errors.hpp"
+#include "base/fault.h"
+#include "linear/linear.hpp"
 #include "newton.hpp"
 #include "softpack_solver.h"
 
@@ -78,7 +78,7 @@ int sp_solver_create(MPI_Comm comm, const sp_solver_options *options, sp_solver 
   if (!s) return SP_SOLVER_ERR_MEMORY;
   *out = s;
   return guarded(s, [&] {
-    // The fault hook (src/fault.h): SOFTPACK_FAULT=solver:RANK fails one
+    // The fault hook (src/base/fault.h): SOFTPACK_FAULT=solver:RANK fails one
     // rank as a library would. The ranks agree on it before the solver's
     // collectives begin, so every rank reports the failure.
     int rank = 0, faulty = -1, faulty_rank = -1;

@@ -26,7 +26,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "errors.hpp"
+#include "base/errors.hpp"
 
 namespace sp {
 namespace {
@@ -61,7 +61,7 @@ const double *local(const NOX::Abstract::Vector &v) {
 }
 
 // The GMRES solvers' options from the scene's: the tolerance as resolved
-// (src/run_options.c turns the scene's 0 into the solver's default).
+// (src/run/run_options.c turns the scene's 0 into the solver's default).
 KrylovOptions krylov_options(const sp_solver_options &options) {
   KrylovOptions k;
   k.tolerance = options.krylov_tol;
@@ -767,7 +767,7 @@ bool Solver::factor_jacobian(std::string &why) {
   linear_->set_rhs_count(1);
   bool ok = linear_->factor(A, !pattern_changed_, why);
   int oom = !ok && linear_->out_of_memory();
-  if (ok && sp_fault_due(SP_FAULT_FACTOR, rank_)) {  // (src/fault.h)
+  if (ok && sp_fault_due(SP_FAULT_FACTOR, rank_)) {  // (src/base/fault.h)
     ok = false;
     oom = 1;
     why = "out of memory in the factorisation on rank " + std::to_string(rank_) +

@@ -7,15 +7,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
-#include "q1.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 #include "softpack_solver.h"
-#include "resize.h"
-#include "stepper.h"
+#include "run/resize.h"
+#include "run/stepper.h"
 
 /** A division's set-up: a 160 x 160 mesh of the unit square, full layouts
  *  of 1 cell (the parent) and 2 (the daughters), their states zeroed;

@@ -18,7 +18,7 @@
  *     max |x_k - x_k,ref| <= 1e-10 max |x_k,ref| for k = 1..4.
  *
  *   mpi_compare library SCENE [section.key=value]...
- *     The library under faults (src/fault.h): with SOFTPACK_FAULT set on
+ *     The library under faults (src/base/fault.h): with SOFTPACK_FAULT set on
  *     every rank to a fault on one rank (at set-up, in the solver's
  *     creation, in a step, at output, inside the glue's residual fill
  *     and where it takes a layout, each before its collective; rank 1,
@@ -53,9 +53,9 @@
 #include <time.h>
 
 #include "fixtures.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "output_read.h"
-#include "run.h"
+#include "public/run.h"
 
 static double rel(double a, double b) {
   double s = fmax(fabs(a), fabs(b));

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "fixtures.h"
-#include "shape.h"
+#include "model/shape.h"
 
 /** The observables (threshold 0) with the nodal c of pair @p p moved by
  *  +step and -step; the state is restored. */

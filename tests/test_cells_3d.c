@@ -1,4 +1,4 @@
-/* The 3x3 inertia tensor of a cell on a 3D mesh (src/cells.c, issue 29
+/* The 3x3 inertia tensor of a cell on a 3D mesh (src/model/cells.c, issue 29
  * phase 2; docs/3d.md):
  *  - the eigensolver (sp_cells_principal3): a tensor R diag(3, 2, 1) R^T
  *    gives back 3, 2, 1 (1e-14 relative) and the rotated axes (1e-14);
@@ -31,13 +31,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "fixtures.h"
-#include "layout.h"
-#include "mesh.h"
-#include "scene.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "scene/scene.h"
 
 /** Centre and inertia integrate c >= this, as the stepper does. */
 #define WEIGHT_THRESHOLD 0.05

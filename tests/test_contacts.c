@@ -1,4 +1,4 @@
-/* Contacts measured from the fields (src/contacts.h; docs/model.md,
+/* Contacts measured from the fields (src/model/contacts.h; docs/model.md,
  * "Contacts"), on the exact equilibrium profile c = 1 / (1 + e^(s/d))
  * interpolated on Q1 meshes of decreasing h (2D quadrilaterals, 3D
  * hexahedra; d fixed):
@@ -37,12 +37,12 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "contacts.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
+#include "model/contacts.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
 #include "output_read.h"
 
 /** A cell's signed distance function (> 0 outside) at x[0..dim). */

@@ -1,4 +1,4 @@
-/* Cell division building blocks (src/division.c): the axis of elliptical
+/* Cell division building blocks (src/model/division.c): the axis of elliptical
  * cells at several orientations, the split's exact mass conservation and
  * equal halves (sharp and smoothed), the crossing-safe criteria, the paper's
  * dt sequence after a division (algorithm 2) and N_max. */
@@ -6,15 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "division.h"
+#include "model/division.h"
 #include "division_fixtures.h"
-#include "error.h"
+#include "public/error.h"
 #include "fixtures.h"
-#include "layout.h"
-#include "mesh.h"
-#include "q1.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 
 #define PI 3.14159265358979323846
 

@@ -1,4 +1,4 @@
-/* Division on a 3D mesh (src/division.c, issue 29 phase 2; docs/3d.md):
+/* Division on a 3D mesh (src/model/division.c, issue 29 phase 2; docs/3d.md):
  * the cut is the plane through the centre of mass normal to the long axis
  * (the eigenvector of the smallest principal moment, sp_division_plane).
  *  - an ellipsoid 0.14 x 0.08 x 0.07 long along x, and the same turned to a
@@ -26,14 +26,14 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "division.h"
+#include "model/division.h"
 #include "division_fixtures.h"
-#include "error.h"
+#include "public/error.h"
 #include "fixtures.h"
-#include "layout.h"
-#include "mesh.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
 
 /** Centre and inertia integrate c >= this, as the stepper does. */
 #define WEIGHT_THRESHOLD 0.05

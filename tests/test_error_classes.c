@@ -1,5 +1,5 @@
 /* The classes of errors at the C/C++ boundary (c_api/softpack_solver.h,
- * src/solver_status.h) and their exit statuses: only bad input exits 2.
+ * src/run/solver_status.h) and their exit statuses: only bad input exits 2.
  * - the glue refuses options as bad input, and null arguments as internal;
  * - every glue status maps to its core code, an unknown one to internal;
  * - a solver creation that fails (the fault hook SOFTPACK_FAULT=solver:0)
@@ -18,11 +18,11 @@
 
 #include "check.h"
 #include "command.h"
-#include "layout.h"
-#include "run.h"
-#include "solver_status.h"
-#include "resize.h"
-#include "stepper.h"
+#include "mesh/layout.h"
+#include "public/run.h"
+#include "run/solver_status.h"
+#include "run/resize.h"
+#include "run/stepper.h"
 
 static const char scene[] =
     "mesh: {type: rectangle, x0: 0, y0: 0, x1: 1, y1: 1, nx: 12, ny: 12}\n"

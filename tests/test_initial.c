@@ -1,4 +1,4 @@
-/* Initial fields from files (src/initial.c):
+/* Initial fields from files (src/io/initial.c):
  * - a label image (three disks of three colours drawn with cairo, no
  *   antialiasing): three cells, numbered by colour; each cell's mass is its
  *   label's pixel area plus the equilibrium profile's own excess
@@ -14,14 +14,14 @@
 #include <cairo.h>
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "error.h"
-#include "initial.h"
+#include "public/error.h"
+#include "io/initial.h"
 #include "output_read.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "scene_fixture.h"
-#include "stepper.h"
+#include "run/stepper.h"
 
 #define W 200
 #define H 100

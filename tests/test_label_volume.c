@@ -1,4 +1,4 @@
-/* Initial fields from a 3D label volume (initial.label_volume, src/initial.c),
+/* Initial fields from a 3D label volume (initial.label_volume, src/io/initial.c),
  * on NIfTI files this test writes with libnifti2:
  * - three ellipsoidal labels (values 3, 7, 12) in a volume whose sform turns
  *   the voxel axes by 90 degrees about z and moves them, placed with
@@ -32,15 +32,15 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
 #include "command.h"
-#include "error.h"
-#include "initial.h"
-#include "layout.h"
-#include "mesh.h"
-#include "run_options.h"
-#include "scene.h"
+#include "public/error.h"
+#include "io/initial.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "run/run_options.h"
+#include "scene/scene.h"
 
 #define N 120              /* voxels a side */
 #define VOXEL 0.5          /* the file's unit (say um) */

@@ -1,6 +1,6 @@
 /* The Jacobian as Newton applies it with the implicit shape term on
  * (sp_solver_apply_jacobian; the sparse matrix plus the low-rank part U C V^T
- * that cxx_glue/linear_low_rank.hpp solves by Woodbury), on three tanh
+ * that cxx_glue/linear/linear_low_rank.hpp solves by Woodbury), on three tanh
  * ellipses that overlap (a full layout on a 32 x 32 mesh), each with its own
  * shape gains:
  * 1. J^T is the transpose of J: <J^T x, y> = <x, J y> for random x, y, to

@@ -15,10 +15,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "layout.h"
-#include "output.h"
-#include "render.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "io/output.h"
+#include "io/render.h"
 #include "output_read.h"
 
 #define DIR "test_output_tmp/run/a"

@@ -1,4 +1,4 @@
-/* test_scene: the scene file reader (src/scene.c).
+/* test_scene: the scene file reader (src/scene/scene.c).
  *
  * - a minimal scene gets every default of the key table;
  * - a scene setting every key gets every value;
@@ -22,9 +22,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "run_options.h"
-#include "scene.h"
+#include "public/error.h"
+#include "run/run_options.h"
+#include "scene/scene.h"
 
 #ifndef SP_SOURCE_DIR
 #error "compile with -DSP_SOURCE_DIR=\"<repository root>\""

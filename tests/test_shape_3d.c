@@ -1,4 +1,4 @@
-/* The shape penalty on the three principal moments of a 3D cell (src/shape.h,
+/* The shape penalty on the three principal moments of a 3D cell (src/model/shape.h,
  * docs/3d.md "Shape term in 3D"):
  * 1. on a tanh ellipsoid with three distinct moments (rotated, on a box of
  *    hexahedra): the glue's Ihat_i = |v_i x Xb|^2 integrated against N_j is
@@ -36,10 +36,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "division.h"
-#include "scene.h"
+#include "model/division.h"
+#include "scene/scene.h"
 #include "shape_fixtures.h"
-#include "stepper.h"
+#include "run/stepper.h"
 
 /** The moment I^(i+1) of observables @p o. */
 static double moment(const sp_cell_obs *o, int i) {

@@ -20,12 +20,12 @@
 #include <string.h>
 
 #include "check.h"
-#include "division.h"
-#include "error.h"
-#include "events.h"
-#include "scene.h"
+#include "model/division.h"
+#include "public/error.h"
+#include "run/events.h"
+#include "scene/scene.h"
 #include "scene_fixture.h"
-#include "step.h"
+#include "run/step.h"
 
 #define BASE                                                                    \
   "mesh: {type: rectangle, x0: 0, y0: 0, x1: 1, y1: 1, nx: 24, ny: 24}\n"       \

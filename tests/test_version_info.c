@@ -9,7 +9,7 @@
 
 #include "check.h"
 #include "command.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "softpack_solver.h"
 
 /** The text after "key: " up to the end of its line, or "" if absent. */
