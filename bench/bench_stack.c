@@ -48,7 +48,7 @@ static result run(int n, int steps, double dt) {
     fprintf(stderr, "setup failed\n");
     exit(1);
   }
-  sp_solver_options opt = {.jacobian = SP_SOLVER_JAC_AD, .linear = SP_SOLVER_SUPERLU,
+  sp_solver_options opt = {.jacobian = SP_SOLVER_JAC_AD, .linear = SP_LINEAR_SUPERLU,
                            .newton_rtol = 1e-8, .newton_atol = 1e-10, .newton_max_its = 12};
   sp_solver s;
   if (sp_solver_create(MPI_COMM_WORLD, &opt, &s) || sp_solver_attach(s, mesh, layout)) {

@@ -15,6 +15,7 @@
 #include <mpi.h>
 #include <stdint.h>
 
+#include "softpack_linear.h"
 #include "softpack_newton.h"
 
 #ifdef __cplusplus
@@ -52,18 +53,6 @@ enum {
   SP_SOLVER_JAC_FD = 2,
   SP_SOLVER_JAC_AD_DFAD = 3
 };
-/** Linear solver of each Newton iteration: direct, or GMRES preconditioned
- *  by ILU(k) (additive Schwarz, one ILU per rank, under MPI). KLU2 is
- *  Amesos2's (one process only), KLU Amesos (v1)'s. */
-enum {
-  SP_SOLVER_SUPERLU = 0,
-  SP_SOLVER_SUPERLU_DIST = 1,
-  SP_SOLVER_MUMPS = 2,
-  SP_SOLVER_KLU2 = 3,
-  SP_SOLVER_GMRES_ILU = 4,
-  SP_SOLVER_KLU = 5,
-  SP_SOLVER_GMRES_CELLS = 6 /**< GMRES on the cells' diagonal blocks (MUMPS) */
-};
 /** SuperLU_DIST's fill-reducing column order: METIS on the graph of the
  *  (cell, node) pairs (c and mu of a pair together), or on the unknowns
  *  (SuperLU_DIST's own METIS_AT_PLUS_A). */
@@ -77,7 +66,7 @@ typedef struct sp_solver_s *sp_solver;
 
 typedef struct {
   int jacobian;        /**< SP_SOLVER_JAC_* */
-  int linear;          /**< SP_SOLVER_SUPERLU, ... */
+  int linear;          /**< sp_linear_kind (softpack_linear.h), not auto */
   double newton_rtol;  /**< ||F|| <= rtol ||F_0|| ... */
   double newton_atol;  /**< ... or ||F|| <= atol (unscaled 2-norm) */
   int newton_max_its;  /**< more iterations count as a failure */
@@ -102,7 +91,7 @@ typedef struct {
   /** SuperLU_DIST only: 1 for one step of iterative refinement per solve
    *  (SuperLU_DIST's default), 0 for none. */
   int refine;
-  /** SP_SOLVER_GMRES_ILU only, taken as given (no defaults here: the
+  /** SP_LINEAR_GMRES_ILU only, taken as given (no defaults here: the
    *  scene's solver.ilu_fill and solver.krylov_tol have them): the ILU(k)
    *  level of fill, >= 0 (0: ILU(0)), and the relative residual of a
    *  linear solve, in (0, 1). */
@@ -343,7 +332,7 @@ const char *sp_solver_trilinos_version(void);
 
 /**
  * @brief What serves a linear solver in this build (softpack info).
- * @param[in] linear SP_SOLVER_SUPERLU, ...
+ * @param[in] linear SP_LINEAR_SUPERLU, ...
  * @param[out] backend the library behind it and its version, e.g.
  *             "SuperLU 5.3.0 (dgstrf)" (static text; NULL: not wanted)
  * @return 1 if this build can use it, 0 if not (an Amesos built without

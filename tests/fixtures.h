@@ -84,7 +84,7 @@ static inline sp_solver make_solver_with(const sp_mesh *mesh, const sp_layout *l
 }
 
 static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout, int jacobian) {
-  return make_solver_with(mesh, layout, jacobian, SP_SOLVER_SUPERLU);
+  return make_solver_with(mesh, layout, jacobian, SP_LINEAR_SUPERLU);
 }
 
 /** The largest relative difference of Jacobian kinds @p a and @p b at

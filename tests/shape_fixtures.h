@@ -79,7 +79,7 @@ typedef struct {
   double threshold;    /**< the moments count c >= this (and the term acts there) */
   double background;   /**< c += background (1 - c) */
   int implicit;        /**< sp_step_data.shape_implicit */
-  int linear;          /**< SP_SOLVER_SUPERLU, ... */
+  int linear;          /**< SP_LINEAR_SUPERLU, ... */
   int steps;
   double dt;
 } relax_setup;

@@ -98,7 +98,7 @@ int main(int argc, char **argv) {
 
   struct Backend {
     const char *name;
-    std::unique_ptr<sp::DirectSolver> solver;
+    std::unique_ptr<sp::LinearSolver> solver;
   };
   std::vector<Backend> backends;
   backends.push_back({"mumps", sp::make_mumps(MPI_COMM_WORLD)});

@@ -61,7 +61,7 @@ int main(int argc, char **argv) {
   struct stat st;
 
   /* options the glue refuses: bad input; a null argument: a bug */
-  sp_solver_options opt = {.jacobian = 99, .linear = SP_SOLVER_SUPERLU, .newton_rtol = 1e-8,
+  sp_solver_options opt = {.jacobian = 99, .linear = SP_LINEAR_SUPERLU, .newton_rtol = 1e-8,
                            .newton_atol = 1e-10, .newton_max_its = 10};
   sp_solver s = NULL;
   int status = sp_solver_create(MPI_COMM_WORLD, &opt, &s);

@@ -89,7 +89,7 @@ static void newton_step(void) {
   model.kappa = 4e-3;
   int its[2];
   for (int j = 0; j < 2; ++j) {
-    sp_solver s = make_solver_with(mesh, layout, kinds[j], SP_SOLVER_MUMPS);
+    sp_solver s = make_solver_with(mesh, layout, kinds[j], SP_LINEAR_MUMPS);
     result[j] = malloc(n * sizeof(double));
     memcpy(result[j], start, n * sizeof(double));
     sp_step_data data = {.dt = 2e-4, .model = model, .state_old = start};

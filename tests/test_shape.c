@@ -361,7 +361,7 @@ static double evolve_i2(double delta2, double iref2_factor, int steps, double th
                         double background, double *i2_start, double *i2_ref) {
   const relax_result r = relax_ellipse((relax_setup){
       .delta2 = delta2, .iref2_factor = iref2_factor, .threshold = threshold,
-      .background = background, .linear = SP_SOLVER_SUPERLU, .steps = steps, .dt = 2e-4});
+      .background = background, .linear = SP_LINEAR_SUPERLU, .steps = steps, .dt = 2e-4});
   CHECK(r.ok, "step %d: %s", r.steps_done + 1, r.failed.reason);
   *i2_start = r.i2_start;
   *i2_ref = r.i2_ref;

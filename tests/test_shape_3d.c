@@ -341,7 +341,7 @@ static prolate_result prolate_steps(double delta3, int implicit, int relax, int 
   sp_cell_obs obs;
   CHECK_OK(sp_cells_observe(mesh, layout, state, threshold, &obs));
   sp_cell_birth birth = {.birth_mass = obs.mass_core};
-  sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_SOLVER_MUMPS);
+  sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_LINEAR_MUMPS);
   /* delta1 != delta2 on the equal pair: their coefficients differ, and
    * only the blend keeps the force isotropic in their eigenspace */
   const double delta[3] = {2e5, 6e5, delta3};

@@ -141,8 +141,8 @@ static void test_newton(int linear, const char *name) {
 static void test_stiff(void) {
   const double delta2 = 1e7, dt = 2e-4;
   const int steps = 20;
-  relax_result imp = relax(delta2, 1, steps, dt, SP_SOLVER_SUPERLU);
-  relax_result exp_ = relax(delta2, 0, steps, dt, SP_SOLVER_SUPERLU);
+  relax_result imp = relax(delta2, 1, steps, dt, SP_LINEAR_SUPERLU);
+  relax_result exp_ = relax(delta2, 0, steps, dt, SP_LINEAR_SUPERLU);
   printf("stiff: delta2 = %g, %d steps of %g, no source, I2 start %.4e, I2,ref %.4e:\n", delta2,
          steps, dt, imp.i2_start, imp.i2_ref);
   printf("  implicit: %d steps, %d Newton its, energy %.6g -> %.6g, largest rise %.1e, "
@@ -162,8 +162,8 @@ static void test_stiff(void) {
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   test_residual();
-  test_newton(SP_SOLVER_SUPERLU, "superlu");
-  test_newton(SP_SOLVER_SUPERLU_DIST, "superlu_dist");
+  test_newton(SP_LINEAR_SUPERLU, "superlu");
+  test_newton(SP_LINEAR_SUPERLU_DIST, "superlu_dist");
   test_stiff();
   MPI_Finalize();
   TEST_DONE();

@@ -2,8 +2,8 @@
 // preconditioner, as AztecOO's GMRES did (issue 31): x0 = 0, the test
 // |b - A x| <= tolerance |b| on the recursive and then the true residual,
 // classical Gram-Schmidt with a second pass (ICGS), the restart and the
-// iteration limit of KrylovOptions. Shared by gmres_ilu (linear_krylov.cpp)
-// and gmres_cells (linear_cells.cpp).
+// iteration limit of KrylovOptions. Shared by gmres_ilu (linear_gmres_ilu.cpp)
+// and gmres_cells (linear_gmres_cells.cpp).
 #ifndef SP_GMRES_HPP
 #define SP_GMRES_HPP
 

@@ -12,6 +12,9 @@
 #include <memory>
 #include <string>
 
+#include "softpack_linear.h"
+#include "softpack_solver.h"
+
 namespace sp {
 
 // This rank's rows of a square n_global x n_global matrix distributed by
@@ -37,9 +40,9 @@ struct CsrRows {
 };
 
 // Every call is collective over the solver's communicator.
-class DirectSolver {
+class LinearSolver {
  public:
-  virtual ~DirectSolver() = default;
+  virtual ~LinearSolver() = default;
   // Factor A. same_pattern: the sparsity pattern (and row distribution)
   // equals the previous call's, so the symbolic work (ordering, symbolic
   // factorisation) can be reused. Returns false on a singular matrix or
@@ -79,25 +82,25 @@ class DirectSolver {
 
 // Serial SuperLU (dgstrf/dgstrs on the transposed CSC view of the CSR); one
 // rank holding all rows.
-std::unique_ptr<DirectSolver> make_superlu();
+std::unique_ptr<LinearSolver> make_superlu();
 // A serial solver run on rank 0 of comm: factor() gathers the rows there,
 // solve() gathers b and scatters x. serial is used on rank 0 only (may be
 // null elsewhere).
-std::unique_ptr<DirectSolver> make_gathered(MPI_Comm comm, std::unique_ptr<DirectSolver> serial);
+std::unique_ptr<LinearSolver> make_gathered(MPI_Comm comm, std::unique_ptr<LinearSolver> serial);
 // SuperLU_DIST (pdgssvx, SLU_NR_loc rows as they are distributed).
 // pair_order: METIS on the (cell, node) pair graph (rows in (c, mu) pairs),
 // else SuperLU_DIST's METIS on the unknowns. refine: one step of iterative
 // refinement per solve.
-std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, bool refine);
+std::unique_ptr<LinearSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, bool refine);
 // MUMPS through its own C interface (dmumps_c) on the rows as they are
 // distributed (linear_mumps.cpp).
-std::unique_ptr<DirectSolver> make_mumps(MPI_Comm comm);
+std::unique_ptr<LinearSolver> make_mumps(MPI_Comm comm);
 // Serial KLU (SuiteSparse's libklu, linear_klu.cpp); one rank holding all
 // rows (make_gathered under MPI).
-std::unique_ptr<DirectSolver> make_klu();
+std::unique_ptr<LinearSolver> make_klu();
 // KLU2 through Amesos2 on a Tpetra copy of the rows; one process only
-// (throws on several: Debian 13.2's Amesos2 is wrong there, STACK.md).
-std::unique_ptr<DirectSolver> make_amesos2_klu2(MPI_Comm comm);
+// (Debian 13.2's Amesos2 is wrong on several: docs/building.md).
+std::unique_ptr<LinearSolver> make_amesos2_klu2(MPI_Comm comm);
 // GMRES (Belos) preconditioned by ILU(fill) (Ifpack2 RILUK; additive
 // Schwarz across ranks), to a residual of tolerance x |b|. fill and
 // tolerance come from the caller (the scene's solver.ilu_fill and
@@ -108,28 +111,40 @@ struct KrylovOptions {
   int max_iterations = 500;
   double tolerance = 0;
 };
-std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options);
+std::unique_ptr<LinearSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options);
 // GMRES (Belos) preconditioned by the Jacobian's cell-diagonal blocks (the
-// entries coupling two cells dropped), factored by MUMPS (linear_cells.cpp);
+// entries coupling two cells dropped), factored by MUMPS (linear_gmres_cells.cpp);
 // needs set_blocks. options.fill is not used.
-std::unique_ptr<DirectSolver> make_cell_blocks(MPI_Comm comm, const KrylovOptions &options);
+std::unique_ptr<LinearSolver> make_cell_blocks(MPI_Comm comm, const KrylovOptions &options);
 // Kokkos initialised once per process (Amesos2's and Tpetra's arrays are
-// Kokkos views), finalised at exit if this started it (linear_krylov.cpp).
+// Kokkos views), finalised at exit if this started it (linear_gmres_ilu.cpp).
 void ensure_kokkos();
 
-// The library behind each backend and its version, from the headers the
-// glue was compiled with (softpack info); static text. SP_STR makes a
+// The Krylov options of the scene's solver options (krylov_tol checked).
+KrylovOptions krylov_options(const sp_solver_options &options);
+
+// Each solver of the table (c_api/softpack_linear.h) defines, in its
+// linear_NAME.cpp, its factory from the scene's solver options and the
+// library behind it with its version, from the headers the glue was
+// compiled with (softpack info; static text; *available set to false when
+// this build cannot serve it, left as it is otherwise). SP_STR makes a
 // string of a version macro's value.
 #define SP_STR_(x) #x
 #define SP_STR(x) SP_STR_(x)
-const char *superlu_version();
-const char *superlu_dist_version();
-const char *mumps_version();
-const char *klu_version();
-const char *amesos2_klu2_version();
-bool amesos2_klu2_available();
-const char *krylov_version();
-const char *cell_blocks_version();
+#define SP_LINEAR_DECLARE_(id, name, ranks)                                              \
+  std::unique_ptr<LinearSolver> make_linear_##name(MPI_Comm comm,                        \
+                                                   const sp_solver_options &options);   \
+  const char *linear_##name##_version(bool *available);
+SP_LINEAR_SOLVERS(SP_LINEAR_DECLARE_)
+#undef SP_LINEAR_DECLARE_
+
+// The solver options.linear names (an sp_linear_kind, not auto) on comm:
+// its factory, wrapped by make_gathered for a serial solver on several
+// ranks; a one-process solver on several ranks is bad input.
+std::unique_ptr<LinearSolver> make_linear_solver(MPI_Comm comm, const sp_solver_options &options);
+// The library and version behind options.linear kind @p kind (-1: no such
+// kind, 0: not served by this build, 1: served).
+int linear_solver_version(int kind, const char **version);
 
 }  // namespace sp
 #endif

@@ -11,9 +11,9 @@
 namespace sp {
 namespace {
 
-class Gathered final : public DirectSolver {
+class Gathered final : public LinearSolver {
  public:
-  Gathered(MPI_Comm comm, std::unique_ptr<DirectSolver> serial) : serial_(std::move(serial)) {
+  Gathered(MPI_Comm comm, std::unique_ptr<LinearSolver> serial) : serial_(std::move(serial)) {
     MPI_Comm_dup(comm, &comm_);
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
@@ -108,14 +108,14 @@ class Gathered final : public DirectSolver {
 
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1, n_local_ = 0;
-  std::unique_ptr<DirectSolver> serial_;
+  std::unique_ptr<LinearSolver> serial_;
   std::vector<int> lengths_, ptr_, col_, row_counts_, row_displs_;
   std::vector<double> val_, b_, x_;
 };
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_gathered(MPI_Comm comm, std::unique_ptr<DirectSolver> serial) {
+std::unique_ptr<LinearSolver> make_gathered(MPI_Comm comm, std::unique_ptr<LinearSolver> serial) {
   return std::make_unique<Gathered>(comm, std::move(serial));
 }
 

@@ -18,7 +18,7 @@
 namespace sp {
 namespace {
 
-class Klu final : public DirectSolver {
+class Klu final : public LinearSolver {
  public:
   Klu() { klu_defaults(&common_); }
   ~Klu() override {
@@ -91,9 +91,13 @@ class Klu final : public DirectSolver {
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_klu() { return std::make_unique<Klu>(); }
+std::unique_ptr<LinearSolver> make_klu() { return std::make_unique<Klu>(); }
 
-const char *klu_version() {
+std::unique_ptr<LinearSolver> make_linear_klu(MPI_Comm, const sp_solver_options &) {
+  return make_klu();
+}
+
+const char *linear_klu_version(bool *) {
   return "KLU " SP_STR(KLU_MAIN_VERSION) "." SP_STR(KLU_SUB_VERSION) "." SP_STR(
       KLU_SUBSUB_VERSION) " (SuiteSparse; gathered on rank 0 under MPI)";
 }

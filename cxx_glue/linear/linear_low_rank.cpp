@@ -73,7 +73,7 @@ void LowRankTerm::add_apply(MPI_Comm comm, const double *x, double *y, bool tran
   add_times(out_ptr, out_col, out_val, w, y);
 }
 
-LowRankSolver::LowRankSolver(MPI_Comm comm, std::unique_ptr<DirectSolver> sparse)
+LowRankSolver::LowRankSolver(MPI_Comm comm, std::unique_ptr<LinearSolver> sparse)
     : comm_(comm), sparse_(std::move(sparse)) {}
 
 void LowRankSolver::set_term(LowRankTerm term) {

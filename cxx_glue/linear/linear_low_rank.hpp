@@ -1,5 +1,5 @@
 // A sparse matrix plus a low-rank term, A + U C V^T, solved with any
-// DirectSolver for A by Sherman-Morrison-Woodbury (the idea of PETSc's
+// LinearSolver for A by Sherman-Morrison-Woodbury (the idea of PETSc's
 // MATLRC): the backend never sees the dense coupling, and the Newton code
 // never sees Woodbury. The implicit shape term (shape_implicit.hpp) is the
 // one user: rank dim (two in 2D, three in 3D) per cell, dense over the cell.
@@ -37,14 +37,14 @@ struct LowRankTerm {
 // depend on its own outcome alone).
 bool all_agree(MPI_Comm comm, bool ok, std::string &why);
 
-// A DirectSolver for A + U C V^T around a DirectSolver for A. factor()
+// A LinearSolver for A + U C V^T around a LinearSolver for A. factor()
 // factors A; the first solve after it solves the right-hand sides and the m
 // columns of U as one block (Z = A^-1 U, kept) and LU-factors the m x m
 // K = I + C V^T Z (identical on every rank); every solve then corrects
 // y = A^-1 b to x = y - Z K^-1 C V^T y. Without a term it passes through.
-class LowRankSolver final : public DirectSolver {
+class LowRankSolver final : public LinearSolver {
  public:
-  LowRankSolver(MPI_Comm comm, std::unique_ptr<DirectSolver> sparse);
+  LowRankSolver(MPI_Comm comm, std::unique_ptr<LinearSolver> sparse);
   // The term of the next factorisations and solves (replaces the last;
   // the factorisation of A stays, Z and K are redone at the next solve).
   void set_term(LowRankTerm term);
@@ -75,7 +75,7 @@ class LowRankSolver final : public DirectSolver {
   void correct(double *x) const;
 
   MPI_Comm comm_;
-  std::unique_ptr<DirectSolver> sparse_;
+  std::unique_ptr<LinearSolver> sparse_;
   LowRankTerm term_;
   int n_rows_ = 0;
   int rhs_count_ = 1;

@@ -42,7 +42,7 @@ namespace {
 constexpr int kJobInit = -1, kJobEnd = -2, kJobAnalyse = 1, kJobFactor = 2, kJobSolve = 3;
 constexpr int kLeanRelaxation = 20;  // ICNTL(14) as MUMPS itself sets it (unsymmetric, one process)
 
-class MumpsSolver final : public DirectSolver {
+class MumpsSolver final : public LinearSolver {
  public:
   explicit MumpsSolver(MPI_Comm comm) {
     MPI_Comm_dup(comm, &comm_);
@@ -223,10 +223,14 @@ class MumpsSolver final : public DirectSolver {
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_mumps(MPI_Comm comm) {
+std::unique_ptr<LinearSolver> make_mumps(MPI_Comm comm) {
   return std::make_unique<MumpsSolver>(comm);
 }
 
-const char *mumps_version() { return "MUMPS " MUMPS_VERSION " (its C interface)"; }
+std::unique_ptr<LinearSolver> make_linear_mumps(MPI_Comm comm, const sp_solver_options &) {
+  return make_mumps(comm);
+}
+
+const char *linear_mumps_version(bool *) { return "MUMPS " MUMPS_VERSION " (its C interface)"; }
 
 }  // namespace sp

@@ -14,7 +14,7 @@
 namespace sp {
 namespace {
 
-class SuperLU final : public DirectSolver {
+class SuperLU final : public LinearSolver {
  public:
   static constexpr double kDiagonalPivotThreshold = 1e-3;
 
@@ -123,9 +123,13 @@ class SuperLU final : public DirectSolver {
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_superlu() { return std::make_unique<SuperLU>(); }
+std::unique_ptr<LinearSolver> make_superlu() { return std::make_unique<SuperLU>(); }
 
-const char *superlu_version() {
+std::unique_ptr<LinearSolver> make_linear_superlu(MPI_Comm, const sp_solver_options &) {
+  return make_superlu();
+}
+
+const char *linear_superlu_version(bool *) {
   return "SuperLU " SP_STR(SUPERLU_MAJOR_VERSION) "." SP_STR(SUPERLU_MINOR_VERSION) "." SP_STR(
       SUPERLU_PATCH_VERSION) " (dgstrf; gathered on rank 0 under MPI)";
 }

@@ -29,7 +29,7 @@
 namespace sp {
 namespace {
 
-class SuperLUDist final : public DirectSolver {
+class SuperLUDist final : public LinearSolver {
  public:
   SuperLUDist(MPI_Comm comm, bool pair_order, bool refine) : pair_order_(pair_order) {
     int P = 1;
@@ -256,11 +256,16 @@ static_assert(sizeof(int_t) == sizeof(int), "SuperLU_DIST built with 64-bit indi
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, bool refine) {
+std::unique_ptr<LinearSolver> make_superlu_dist(MPI_Comm comm, bool pair_order, bool refine) {
   return std::make_unique<SuperLUDist>(comm, pair_order, refine);
 }
 
-const char *superlu_dist_version() {
+std::unique_ptr<LinearSolver> make_linear_superlu_dist(MPI_Comm comm,
+                                                      const sp_solver_options &options) {
+  return make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS, options.refine != 0);
+}
+
+const char *linear_superlu_dist_version(bool *) {
   return "SuperLU_DIST " SP_STR(SUPERLU_DIST_MAJOR_VERSION) "." SP_STR(
       SUPERLU_DIST_MINOR_VERSION) "." SP_STR(SUPERLU_DIST_PATCH_VERSION) " (pdgssvx)";
 }

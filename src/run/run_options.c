@@ -25,26 +25,23 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
 
 void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt) {
   static const int jacobian[] = {SP_SOLVER_JAC_AD, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD};
-  static const int linear[] = {SP_SOLVER_SUPERLU, SP_SOLVER_SUPERLU_DIST,
-                               SP_SOLVER_MUMPS, SP_SOLVER_KLU2, SP_SOLVER_GMRES_ILU,
-                               SP_SOLVER_KLU, SP_SOLVER_GMRES_CELLS};
   opt->jacobian = jacobian[scene->solver.jacobian];
   /* auto: the cells' blocks in 3D, where a direct LU of the coupled
    * cells runs out of memory, MUMPS in 2D (docs/3d.md, "GMRES on the
    * cells' blocks") */
   opt->linear = scene->solver.linear == SP_LINEAR_AUTO
-                    ? (sp_scene_dim(scene) == 3 ? SP_SOLVER_GMRES_CELLS : SP_SOLVER_MUMPS)
-                    : linear[scene->solver.linear];
+                    ? (sp_scene_dim(scene) == 3 ? SP_LINEAR_GMRES_CELLS : SP_LINEAR_MUMPS)
+                    : (int)scene->solver.linear;
   opt->newton_rtol = scene->solver.newton_rtol;
   opt->newton_atol = scene->solver.newton_atol;
   opt->newton_max_its = scene->solver.newton_max_its;
   opt->ilu_fill = scene->solver.ilu_fill;
   /* 0: the solver's own tolerance. GMRES on the cells' blocks keeps each
-   * cell's mass at any tolerance (cxx_glue/linear/linear_cells.cpp), and 1e-4
+   * cell's mass at any tolerance (cxx_glue/linear/linear_gmres_cells.cpp), and 1e-4
    * changes the 3D run 5 by 1e-8 (docs/3d.md); ILU's does not, hence its
    * 1e-10 */
   opt->krylov_tol = scene->solver.krylov_tol > 0 ? scene->solver.krylov_tol
-                    : opt->linear == SP_SOLVER_GMRES_CELLS ? 1e-4
+                    : opt->linear == SP_LINEAR_GMRES_CELLS ? 1e-4
                                                            : 1e-10;
   opt->jacobian_reuse = scene->solver.jacobian_reuse;
   opt->jacobian_carry = scene->solver.jacobian_carry;

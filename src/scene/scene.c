@@ -166,15 +166,9 @@ static const cyaml_strval_t sp_profile_words[] = {
     {"tanh", SP_PROFILE_TANH}, {"sharp", SP_PROFILE_SHARP}};
 static const cyaml_strval_t sp_jacobian_words[] = {
     {"ad", SP_JAC_AD}, {"hand", SP_JAC_HAND}, {"fd", SP_JAC_FD}};
-static const cyaml_strval_t sp_linear_words[] = {
-    {"superlu", SP_LINEAR_SUPERLU},
-    {"superlu_dist", SP_LINEAR_SUPERLU_DIST},
-    {"mumps", SP_LINEAR_MUMPS},
-    {"klu", SP_LINEAR_KLU},
-    {"klu2", SP_LINEAR_KLU2},
-    {"gmres_ilu", SP_LINEAR_GMRES_ILU},
-    {"gmres_cells", SP_LINEAR_GMRES_CELLS},
-    {"auto", SP_LINEAR_AUTO}};
+#define SP_LINEAR_WORD_(id, name, ranks) {#name, SP_LINEAR_##id},
+static const cyaml_strval_t sp_linear_words[] = {SP_LINEAR_SOLVERS(SP_LINEAR_WORD_){"auto", SP_LINEAR_AUTO}};
+#undef SP_LINEAR_WORD_
 static const cyaml_strval_t sp_ordering_words[] = {
     {"pairs", SP_ORDER_PAIRS}, {"unknowns", SP_ORDER_UNKNOWNS}};
 static const cyaml_strval_t sp_control_words[] = {

@@ -13,6 +13,7 @@
 #include <stdio.h>
 
 #include "public/cell_obs.h"
+#include "softpack_linear.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -33,19 +34,7 @@ typedef enum { SP_PREDICT_NONE = 0, SP_PREDICT_LINEAR = 1 } sp_predictor_kind;
 typedef enum { SP_STEP_FULL = 0, SP_STEP_BACKTRACK = 1 } sp_line_search_kind;
 /** SuperLU_DIST's column order: METIS on the (cell, node) pairs or on the unknowns. */
 typedef enum { SP_ORDER_PAIRS = 0, SP_ORDER_UNKNOWNS = 1 } sp_ordering_kind;
-typedef enum {
-  SP_LINEAR_SUPERLU = 0,
-  SP_LINEAR_SUPERLU_DIST = 1,
-  SP_LINEAR_MUMPS = 2,
-  SP_LINEAR_KLU2 = 3, /**< KLU2 through Amesos2 */
-  SP_LINEAR_GMRES_ILU = 4,
-  SP_LINEAR_KLU = 5, /**< Amesos (v1)'s KLU */
-  SP_LINEAR_GMRES_CELLS = 6, /**< GMRES, the cells' blocks by MUMPS */
-  SP_LINEAR_LAST = SP_LINEAR_GMRES_CELLS, /**< the kinds are 0 .. SP_LINEAR_LAST */
-  /** the default: gmres_cells on a 3D mesh, mumps on a 2D one
-   *  (sp_solver_options_from_scene resolves it) */
-  SP_LINEAR_AUTO = SP_LINEAR_LAST + 1
-} sp_linear_kind;
+/* solver.linear: sp_linear_kind, the table of c_api/softpack_linear.h */
 
 /** mesh: the domain and its discretisation. */
 typedef struct {

@@ -11,7 +11,7 @@
 // One MUMPS instance factors all blocks at once (its ordering finds the
 // independent blocks); under MPI the rows stay distributed as they are.
 // The preconditioner is on the right (A M^-1 y = b, x = M^-1 y), the start
-// x0 = 0, the test |b - A x| <= tolerance |b|, as linear_krylov.cpp's.
+// x0 = 0, the test |b - A x| <= tolerance |b|, as linear_gmres_ilu.cpp's.
 // The filter (which entries of A stay) is built once per pattern; each
 // factor() copies the values through it.
 //
@@ -49,7 +49,7 @@ using Map = TpetraRows::Map;
 // at a time. A failed solve throws (Belos passes it on to solve()).
 class InnerSolveOperator final : public OP {
  public:
-  InnerSolveOperator(Teuchos::RCP<const Map> map, DirectSolver *inner)
+  InnerSolveOperator(Teuchos::RCP<const Map> map, LinearSolver *inner)
       : map_(std::move(map)), inner_(inner) {}
   Teuchos::RCP<const Map> getDomainMap() const override { return map_; }
   Teuchos::RCP<const Map> getRangeMap() const override { return map_; }
@@ -73,13 +73,13 @@ class InnerSolveOperator final : public OP {
 
  private:
   Teuchos::RCP<const Map> map_;
-  DirectSolver *inner_;
+  LinearSolver *inner_;
   mutable std::vector<double> b_, x_;
 };
 
-class CellBlockSolver final : public DirectSolver {
+class CellBlockSolver final : public LinearSolver {
  public:
-  CellBlockSolver(MPI_Comm comm, const KrylovOptions &o, std::unique_ptr<DirectSolver> inner)
+  CellBlockSolver(MPI_Comm comm, const KrylovOptions &o, std::unique_ptr<LinearSolver> inner)
       : comm_(Teuchos::rcp(new Teuchos::MpiComm<int>(comm))), o_(o), inner_(std::move(inner)) {
     ensure_kokkos();
   }
@@ -158,7 +158,7 @@ class CellBlockSolver final : public DirectSolver {
 
   Teuchos::RCP<const Teuchos::Comm<int>> comm_;
   KrylovOptions o_;
-  std::unique_ptr<DirectSolver> inner_;
+  std::unique_ptr<LinearSolver> inner_;
   std::vector<int> block_;               // the cell of each global row
   std::unique_ptr<TpetraRows> rows_;     // A, for GMRES
   std::vector<int> keep_, ptr_, col_;    // the cell-diagonal part's entries of A
@@ -170,11 +170,16 @@ class CellBlockSolver final : public DirectSolver {
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_cell_blocks(MPI_Comm comm, const KrylovOptions &options) {
+std::unique_ptr<LinearSolver> make_cell_blocks(MPI_Comm comm, const KrylovOptions &options) {
   return std::make_unique<CellBlockSolver>(comm, options, make_mumps(comm));
 }
 
-const char *cell_blocks_version() {
+std::unique_ptr<LinearSolver> make_linear_gmres_cells(MPI_Comm comm,
+                                                     const sp_solver_options &options) {
+  return make_cell_blocks(comm, krylov_options(options));
+}
+
+const char *linear_gmres_cells_version(bool *) {
   return "Belos GMRES preconditioned by the cells' diagonal blocks, factored by MUMPS";
 }
 

@@ -33,6 +33,7 @@
 #include <utility>
 #include <vector>
 
+#include "base/errors.hpp"
 #include "linear/gmres.hpp"
 #include "linear/linear.hpp"
 #include "linear/tpetra_rows.hpp"
@@ -58,7 +59,7 @@ using MV = TpetraRows::MV;
 using OP = Tpetra::Operator<double, int, GO>;
 using Prec = Ifpack2::Preconditioner<double, int, GO>;
 
-class KrylovSolver final : public DirectSolver {
+class KrylovSolver final : public LinearSolver {
  public:
   KrylovSolver(MPI_Comm comm, const KrylovOptions &o)
       : comm_(Teuchos::rcp(new Teuchos::MpiComm<int>(comm))), o_(o) {
@@ -148,11 +149,22 @@ class KrylovSolver final : public DirectSolver {
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options) {
+std::unique_ptr<LinearSolver> make_krylov(MPI_Comm comm, const KrylovOptions &options) {
   return std::make_unique<KrylovSolver>(comm, options);
 }
 
-const char *krylov_version() {
+std::unique_ptr<LinearSolver> make_linear_gmres_ilu(MPI_Comm comm,
+                                                   const sp_solver_options &options) {
+  // taken as given: 0 is ILU(0), not a default (the scene has those)
+  if (options.ilu_fill < 0)
+    throw input_error("solver.ilu_fill: expected a fill level >= 0, got " +
+                      std::to_string(options.ilu_fill));
+  KrylovOptions k = krylov_options(options);
+  k.fill = options.ilu_fill;
+  return make_krylov(comm, k);
+}
+
+const char *linear_gmres_ilu_version(bool *) {
   return "Belos GMRES, Ifpack2 RILUK ILU(k) (Trilinos " TRILINOS_VERSION_STRING
          "; additive Schwarz under MPI)";
 }

@@ -23,7 +23,7 @@ namespace {
 using Matrix = TpetraRows::Matrix;
 using MV = TpetraRows::MV;
 
-class Amesos2Klu2 final : public DirectSolver {
+class Amesos2Klu2 final : public LinearSolver {
  public:
   explicit Amesos2Klu2(MPI_Comm comm) : comm_(Teuchos::rcp(new Teuchos::MpiComm<int>(comm))) {
     if (comm_->getSize() != 1)
@@ -108,13 +108,18 @@ class Amesos2Klu2 final : public DirectSolver {
 
 }  // namespace
 
-std::unique_ptr<DirectSolver> make_amesos2_klu2(MPI_Comm comm) {
+std::unique_ptr<LinearSolver> make_amesos2_klu2(MPI_Comm comm) {
   return std::make_unique<Amesos2Klu2>(comm);
 }
 
-bool amesos2_klu2_available() { return Amesos2::query("KLU2"); }
+std::unique_ptr<LinearSolver> make_linear_klu2(MPI_Comm comm, const sp_solver_options &) {
+  return make_amesos2_klu2(comm);
+}
 
-const char *amesos2_klu2_version() {
+// Debian 13.2's Amesos2 KLU2 returns wrong solutions on several ranks (a
+// gcc 12 miscompile, docs/building.md): the table marks it SP_LINEAR_SERIAL.
+const char *linear_klu2_version(bool *available) {
+  *available = Amesos2::query("KLU2");
   return "KLU2 through Amesos2 (Trilinos " TRILINOS_VERSION_STRING "; one process only)";
 }
 
