@@ -40,6 +40,7 @@
 #include "model/cells.h"
 #include "check.h"
 #include "model/contacts.h"
+#include "io/contacts_out.h"
 #include "public/error.h"
 #include "mesh/layout.h"
 #include "mesh/mesh.h"
@@ -245,7 +246,7 @@ static void test_lone_and_apart(void) {
       CHECK(at(&t, i, "other") == 0 && at(&t, i, "cell") == i + 1, "row %d not a cell row", i);
       CHECK(at(&t, i, "contact") == 0, "row %d: contact %g", i, at(&t, i, "contact"));
       CHECK(at(&t, i, "free_surface") == at(&t, i, "surface"), "row %d: free != total", i);
-      CHECK(at(&t, i, "volume") == obs[i].area, "row %d: volume is not cells.csv's area", i);
+      CHECK(at(&t, i, "volume") == obs[i].volume, "row %d: volume is not cells.csv's area", i);
     }
     free(t.v);
     free(state);

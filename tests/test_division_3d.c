@@ -107,10 +107,10 @@ static void check_split(const sp_mesh *mesh, const double axes[3][3], int smooth
   CHECK(worst_sum <= 1e-15, "%s: |c_parent + c_child - c| up to %.3g", label, worst_sum);
 
   /* the daughters' centres: apart along the long axis, the child on n's side */
-  const double apart[3] = {after[2].xc - after[0].xc, after[2].yc - after[0].yc,
-                           after[2].zc - after[0].zc};
-  const double child_side[3] = {after[2].xc - point[0], after[2].yc - point[1],
-                                after[2].zc - point[2]};
+  const double apart[3] = {after[2].centre[0] - after[0].centre[0], after[2].centre[1] - after[0].centre[1],
+                           after[2].centre[2] - after[0].centre[2]};
+  const double child_side[3] = {after[2].centre[0] - point[0], after[2].centre[1] - point[1],
+                                after[2].centre[2] - point[2]};
   const double apart_angle = line_angle3(apart, axes[0]), distance = norm3(apart);
   const double expected = halves_apart(semi[0], width / semi[2]);
   const double unequal = fabs(m_parent - m_child) / (0.5 * (m_parent + m_child));

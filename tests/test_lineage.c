@@ -87,7 +87,7 @@ static void test_asymmetric_split(void) {
         CHECK(off <= allowed, "fixed %d smooth %d: share %.12f for %g (allowed %.3g)", fixed,
               smooth, share, e.fraction, allowed);
         /* the first daughter on the side the normal points away from */
-        const double c0[2] = {after[0].xc, after[0].yc}, c1[2] = {after[1].xc, after[1].yc};
+        const double c0[2] = {after[0].centre[0], after[0].centre[1]}, c1[2] = {after[1].centre[0], after[1].centre[1]};
         CHECK(dot2(c0, normal) < dot2(c1, normal), "fixed %d: the first daughter is on the "
               "normal's side", fixed);
         if (fixed) /* the user's direction */

@@ -44,7 +44,7 @@ static void test_residual(void) {
   CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &obs_new));
   const double delta1 = 3e5, delta2 = 7e5;
   const sp_cell_birth birth = {.birth_mass = obs_old.mass,
-                               .Iref = {0.9 * obs_old.I1, 1.2 * obs_old.I2}};
+                               .Iref = {0.9 * obs_old.moments[0], 1.2 * obs_old.moments[1]}};
   sp_shape_coef coef;
   CHECK_OK(sp_shape_coefficients(2, 1, &obs_old, &birth, (double[3]){delta1, delta2, 0}, &coef));
   coef.threshold = 0.0;
@@ -80,7 +80,7 @@ static void test_residual(void) {
     scale = fmax(scale, fabs(dE));
   }
   printf("residual: minor axis +%.0f%% (I2 %.4e -> %.4e), delta = (%g, %g):\n", 100 * growth,
-         obs_old.I2, obs_new.I2, delta1, delta2);
+         obs_old.moments[1], obs_new.moments[1], delta1, delta2);
   printf("  max |R_mu(with) - R_mu(without) + dE_shape/dc(new state)| / max |dE/dc|: "
          "implicit %.2e, explicit %.2e; schemes at c^n differ by %.1e\n",
          err_implicit / scale, err_explicit / scale, same);

@@ -154,7 +154,7 @@ static void landing(void) {
   CHECK_OK(sp_step_complete(run, &a));
   double closest = INFINITY;
   for (int k = 0; k < run->layout->n_cells; ++k) {
-    const double threshold = sp_division_threshold(&run->division, &run->cells.birth[k]);
+    const double threshold = sp_division_threshold(&run->opt.division.rule, &run->cells.birth[k]);
     closest = fmin(closest, fabs(run->cells.obs[k].mass_core / threshold - 1));
   }
   CHECK(closest <= SP_MASS_LANDING_TOLERANCE,

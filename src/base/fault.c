@@ -61,6 +61,21 @@ int sp_fault_interrupt_due(int rank, int step, int attempt) {
          s == step && a == attempt;
 }
 
+/* The attempt in progress of this process's run, as an interrupt fault
+ * counts it: its step, its number within the step, the stop polls in it. */
+static int attempt_step, attempt_number, attempt_polls;
+
+void sp_fault_attempt_begin(int step, int first_of_step) {
+  if (first_of_step) attempt_number = 0;
+  attempt_step = step;
+  ++attempt_number;
+  attempt_polls = 0;
+}
+
+int sp_fault_interrupt_poll(int rank) {
+  return ++attempt_polls == 2 && sp_fault_interrupt_due(rank, attempt_step, attempt_number);
+}
+
 int sp_fault_check(sp_fault_phase phase, int rank) {
   int p, r, kill;
   long step, attempt;

@@ -58,6 +58,16 @@ int sp_fault_due(sp_fault_phase phase, int rank);
  *         @p step and @p attempt (1, 2, ...). */
 int sp_fault_interrupt_due(int rank, int step, int attempt);
 
+/** @brief An attempt at step @p step (1, 2, ...) begins: the first of its
+ *         step, or a retry (the interrupt fault's ATTEMPT counts them). */
+void sp_fault_attempt_begin(int step, int first_of_step);
+
+/** @brief A stop poll of the attempt in progress (after each Newton
+ *         iteration): 1 at its second poll, the first one after an
+ *         iteration, if SOFTPACK_FAULT=interrupt names @p rank, the step
+ *         and the attempt. */
+int sp_fault_interrupt_poll(int rank);
+
 /**
  * @brief SP_OK, or the error a fault at @p phase stands for on @p rank
  *        (message naming the phase, the rank and SOFTPACK_FAULT). At

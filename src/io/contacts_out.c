@@ -20,7 +20,7 @@ int sp_contacts_log_write(sp_contacts_log *log, int step, double t, const sp_con
     double contact, free_surface;
     sp_contacts_of_cell(c, k, threshold, &contact, &free_surface);
     printed = fprintf(log->f, "%d,%.17g,%d,0,%.17g,%.17g,%.17g,%.17g\n", step, t, k + 1,
-                      contact, obs[k].area, c->surface[k], free_surface);
+                      contact, obs[k].volume, c->surface[k], free_surface);
   }
   for (int k = 0; k < n && printed >= 0; ++k)
     for (int l = k + 1; l < n && printed >= 0; ++l)
@@ -53,9 +53,7 @@ int sp_contacts_picture(const sp_contacts *c, const sp_mesh *mesh, const sp_cell
   if (!length || !edge) rc = sp_error_set(SP_ERR_MEMORY, "out of memory for the contact graph");
   int n_edges = 0;
   for (int k = 0; k < n && rc == SP_OK; ++k) {
-    centre[dim * k] = obs[k].xc;
-    centre[dim * k + 1] = obs[k].yc;
-    if (dim == 3) centre[dim * k + 2] = obs[k].zc;
+    for (int d = 0; d < dim; ++d) centre[dim * k + d] = obs[k].centre[d];
     for (int l = k + 1; l < n; ++l)
       if (sp_contacts_touch(c, k, l, threshold)) {
         edge[2 * n_edges] = k;

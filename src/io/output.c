@@ -377,17 +377,18 @@ int sp_output_cells(sp_output out, int step, double t, int n_cells,
   int n = 0;
   /* a named scene's rows end with the name */
   for (int k = 0; k < n_cells && n >= 0; ++k) {
+    const sp_cell_obs *o = &obs[k];
+    const double *c = o->centre, *I = o->moments, *v = o->axes[o->long_axis];
     if (out->dim == 3)
       n = fprintf(out->cells,
                   "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
                   "%.17g,%.17g",
-                  step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].zc, obs[k].I1,
-                  obs[k].I2, obs[k].I3, obs[k].v3[0], obs[k].v3[1], obs[k].v3[2],
-                  obs[k].mass_core, obs[k].area);
+                  step, t, k + 1, o->mass, c[0], c[1], c[2], I[0], I[1], I[2], v[0], v[1], v[2],
+                  o->mass_core, o->volume);
     else
       n = fprintf(out->cells, "%d,%.17g,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
-                  step, t, k + 1, obs[k].mass, obs[k].xc, obs[k].yc, obs[k].I1,
-                  obs[k].I2, obs[k].angle, obs[k].mass_core, obs[k].area);
+                  step, t, k + 1, o->mass, c[0], c[1], I[0], I[1], sp_cells_obs_angle(o, 2),
+                  o->mass_core, o->volume);
     if (n >= 0 && out->named) n = fprintf(out->cells, ",%s", names ? names[k] : "");
     if (n >= 0) n = fprintf(out->cells, "\n");
   }

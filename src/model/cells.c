@@ -13,32 +13,11 @@ double sp_cells_line_angle(double dx, double dy) {
   return angle;
 }
 
-void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
-                        double *I2, double v1[2], double v2[2]) {
-  const double mean = 0.5 * (Ixx + Iyy);
-  const double radius = hypot(0.5 * (Ixx - Iyy), Ixy);
-  *I1 = mean + radius;
-  *I2 = mean - radius;
-  /* Eigenvector of the larger eigenvalue at angle theta with
-   * tan(2 theta) = 2 Ixy / (Ixx - Iyy); any direction when round. */
-  double theta = 0.5 * atan2(2.0 * Ixy, Ixx - Iyy);
-  /* A line has two unit directions, and v1's sign decides which daughter
-   * takes the new label at a division (the side v2 points to). theta above
-   * lies in (-pi/2, pi/2], whose ends are both the vertical direction:
-   * there the sign of a round-off-sized Ixy picks the end, so the labels of
-   * a vertical cut (symmetric scenes make them) flipped between runs that
-   * differ only in round-off. Wrapped into (phi0 - pi/2, phi0 + pi/2], the
-   * flip sits at phi0 + pi/2 = 101.5 degrees, away from the axes and the
-   * diagonals. */
-  const double phi0 = 0.2;
-  if (theta <= phi0 - M_PI / 2) theta += M_PI;
-  v1[0] = cos(theta);
-  v1[1] = sin(theta);
-  v2[0] = -v1[1];
-  v2[1] = v1[0];
+double sp_cells_obs_angle(const sp_cell_obs *o, int dim) {
+  return dim == 2 ? sp_cells_line_angle(o->axes[0][0], o->axes[0][1]) : 0.0;
 }
 
-/** Cyclic Jacobi sweeps of sp_cells_principal3: each sweep squares the
+/** Cyclic Jacobi sweeps of sp_cells_principal: each sweep squares the
  *  off-diagonal part's size (quadratic convergence); 3x3 tensors reach
  *  round-off in 4 to 6, so this bound is never the one that stops. */
 #define SP_JACOBI_MAX_SWEEPS 50
@@ -52,11 +31,13 @@ void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
 #define SP_JACOBI_THETA_LARGE 1e150
 
 /** A generic direction, r = (-sin 0.2 cos 0.5, cos 0.2 cos 0.5, sin 0.5):
- *  sp_cells_principal3 makes every eigenvector's r component >= 0. Its
+ *  sp_cells_principal makes every eigenvector's r component >= 0. Its
  *  plane r . v = 0, where round-off can flip a sign, contains no
  *  coordinate axis, face or body diagonal; and for an axis in the xy plane
- *  the rule is sp_cells_principal's for v2 (the long axis of 2D), so an
- *  extruded 2D scene gets the 2D signs. */
+ *  the sign of an axis in the xy plane depends on its direction there
+ *  only, so an extruded 2D scene gets the 2D signs. In 2D the flip line is
+ *  at 0.2 + pi/2 rad (101.5 degrees) from the x axis, away from the axes
+ *  and the diagonals, where symmetric scenes put their cuts. */
 static void reference_direction(double r[3]) {
   const double phi0 = 0.2, beta = 0.5;
   r[0] = -sin(phi0) * cos(beta);
@@ -64,16 +45,16 @@ static void reference_direction(double r[3]) {
   r[2] = sin(beta);
 }
 
-void sp_cells_principal3(const double tensor[3][3], double moments[3], double v[3][3]) {
-  double a[3][3], e[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}; /* e: columns */
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) a[i][j] = 0.5 * (tensor[i][j] + tensor[j][i]);
+void sp_cells_principal(int dim, const double tensor[3][3], double moments[3], double v[3][3]) {
+  double a[3][3] = {{0}}, e[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}; /* e: columns */
+  for (int i = 0; i < dim; ++i)
+    for (int j = 0; j < dim; ++j) a[i][j] = 0.5 * (tensor[i][j] + tensor[j][i]);
   for (int sweep = 0; sweep < SP_JACOBI_MAX_SWEEPS; ++sweep) {
     const double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
     const double diag = fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2]);
     if (off == 0.0 || off <= SP_JACOBI_OFF_DIAGONAL * diag) break;
-    for (int p = 0; p < 2; ++p)
-      for (int q = p + 1; q < 3; ++q) {
+    for (int p = 0; p < dim - 1; ++p)
+      for (int q = p + 1; q < dim; ++q) {
         if (a[p][q] == 0.0) continue;
         /* the rotation in the (p, q) plane that zeroes a[p][q]: t = tan of
          * its angle, the smaller root of t^2 + 2 theta t - 1 = 0 */
@@ -100,9 +81,9 @@ void sp_cells_principal3(const double tensor[3][3], double moments[3], double v[
         }
       }
   }
-  /* largest first: a three-element insertion sort of the column indices */
+  /* largest first: an insertion sort of the dim column indices */
   int order[3] = {0, 1, 2};
-  for (int i = 1; i < 3; ++i)
+  for (int i = 1; i < dim; ++i)
     for (int j = i; j > 0 && a[order[j]][order[j]] > a[order[j - 1]][order[j - 1]]; --j) {
       const int swap = order[j];
       order[j] = order[j - 1];
@@ -112,15 +93,17 @@ void sp_cells_principal3(const double tensor[3][3], double moments[3], double v[
   reference_direction(r);
   for (int i = 0; i < 3; ++i) {
     const int col = order[i];
-    moments[i] = a[col][col];
+    moments[i] = i < dim ? a[col][col] : 0.0;
+    for (int k = 0; k < 3; ++k) v[i][k] = 0.0;
+    if (i >= dim) continue;
     double norm = 0, dot = 0;
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < dim; ++k) {
       norm += e[k][col] * e[k][col];
       dot += e[k][col] * r[k];
     }
     /* one line, two unit directions: the one with r . v >= 0 */
     const double scale = (dot < 0 ? -1.0 : 1.0) / sqrt(norm);
-    for (int k = 0; k < 3; ++k) v[i][k] = e[k][col] * scale;
+    for (int k = 0; k < dim; ++k) v[i][k] = e[k][col] * scale;
   }
 }
 
@@ -182,30 +165,24 @@ int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *
   return SP_OK;
 }
 
-/** The 3D tensor I = int c (|Xb|^2 Id - Xb Xb^T) of a cell from its
- *  central second moments (xx = int c Xb1^2, xz = int c Xb1 Xb3, ...), its
- *  principal moments and axes. */
-static void inertia_3d(sp_cell_obs *o, double xx, double yy, double xy, double zz, double xz,
-                       double yz) {
-  o->Ixx = yy + zz;
-  o->Iyy = xx + zz;
-  o->Izz = xx + yy;
-  o->Ixy = -xy;
-  o->Ixz = -xz;
-  o->Iyz = -yz;
-  const double tensor[3][3] = {
-      {o->Ixx, o->Ixy, o->Ixz}, {o->Ixy, o->Iyy, o->Iyz}, {o->Ixz, o->Iyz, o->Izz}};
-  double moments[3], v[3][3];
-  sp_cells_principal3(tensor, moments, v);
-  o->I1 = moments[0];
-  o->I2 = moments[1];
-  o->I3 = moments[2];
-  for (int k = 0; k < 3; ++k) {
-    o->v1[k] = v[0][k];
-    o->v2[k] = v[1][k];
-    o->v3[k] = v[2][k];
+/** The tensor I = int c (|Xb|^2 Id - Xb Xb^T) of a cell from its central
+ *  second moments M[i][j] = int c Xb_i Xb_j (i, j < dim): I_ii is the sum
+ *  of the other diagonal moments, I_ij = -M_ij; then its principal moments
+ *  and axes. */
+static void inertia(int dim, const double M[3][3], sp_cell_obs *o) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) o->inertia[i][j] = 0.0;
+  for (int i = 0; i < dim; ++i) {
+    int first = 1;
+    for (int j = 0; j < dim; ++j) {
+      if (j == i) continue;
+      o->inertia[i][i] = first ? M[j][j] : o->inertia[i][i] + M[j][j];
+      first = 0;
+      o->inertia[i][j] = -M[i][j];
+    }
   }
-  o->angle = 0.0;
+  sp_cells_principal(dim, (const double(*)[3])o->inertia, o->moments, o->axes);
+  o->long_axis = dim - 1;
 }
 
 int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
@@ -217,10 +194,10 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
   const int dim = mesh->dim, nen = mesh->nodes_per_elem, nq = sp_q1_qpoints(dim);
   double N[SP_Q1_MAX_QPOINTS][SP_Q1_MAX_NODES];
   reference_shapes(dim, N);
-  /* Per cell: mass, weighted mass, first and second moments (x, y), the
-   * area (2D) or volume (3D) inside the membrane, and in 3D the first
-   * moment in z and the second moments zz, xz, yz. */
-  enum { SUMS = 12 };
+  /* Per cell: mass, weighted mass, the volume (an area in 2D) inside the
+   * membrane, the weighted first moments (x, y, z) and second moments
+   * (xx, xy, xz, yy, yz, zz: the upper triangle by rows) */
+  enum { MASS, CORE, VOLUME, FIRST, SECOND = FIRST + 3, SUMS = SECOND + 6 };
   double *sums;
   SP_ALLOC(sums, SUMS * (size_t)nc);
   for (int e = 0; e < mesh->n_elems; ++e) {
@@ -233,20 +210,13 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
         double c = 0;
         for (int b = 0; b < nen; ++b) c += N[q][b] * state[2 * pairs[b]];
         double *s = sums + SUMS * t->slot_cell[slot];
-        s[0] += w * c;
-        if (c >= 0.5) s[7] += w;
+        s[MASS] += w * c;
+        if (c >= 0.5) s[VOLUME] += w;
         const double cw = c >= weight_threshold ? c : 0.0;
-        s[1] += w * cw;
-        s[2] += w * cw * x[0];
-        s[3] += w * cw * x[1];
-        s[4] += w * cw * x[0] * x[0];
-        s[5] += w * cw * x[1] * x[1];
-        s[6] += w * cw * x[0] * x[1];
-        if (dim == 3) {
-          s[8] += w * cw * x[2];
-          s[9] += w * cw * x[2] * x[2];
-          s[10] += w * cw * x[0] * x[2];
-          s[11] += w * cw * x[1] * x[2];
+        s[CORE] += w * cw;
+        for (int i = 0, ij = SECOND; i < dim; ++i) {
+          s[FIRST + i] += w * cw * x[i];
+          for (int j = i; j < dim; ++j) s[ij++] += w * cw * x[i] * x[j];
         }
       }
     }
@@ -254,30 +224,15 @@ int sp_cells_observe(const sp_mesh *mesh, const sp_layout *layout,
   for (int k = 0; k < nc; ++k) {
     const double *s = sums + SUMS * k;
     sp_cell_obs *o = obs + k;
-    o->mass = s[0];
-    o->area = s[7];
-    o->mass_core = s[1];
-    const double m = s[1] > 0 ? s[1] : 1.0;
-    o->xc = s[2] / m;
-    o->yc = s[3] / m;
-    o->zc = dim == 3 ? s[8] / m : 0.0;
-    /* Central moments: int c Xb1^2 = int c x^2 - m xc^2, etc. */
-    const double xx = s[4] - m * o->xc * o->xc;
-    const double yy = s[5] - m * o->yc * o->yc;
-    const double xy = s[6] - m * o->xc * o->yc;
-    if (dim == 3) {
-      inertia_3d(o, xx, yy, xy, s[9] - m * o->zc * o->zc, s[10] - m * o->xc * o->zc,
-                 s[11] - m * o->yc * o->zc);
-      continue;
-    }
-    o->Ixx = yy;
-    o->Iyy = xx;
-    o->Ixy = -xy;
-    sp_cells_principal(o->Ixx, o->Iyy, o->Ixy, &o->I1, &o->I2, o->v1, o->v2);
-    o->v1[2] = o->v2[2] = 0.0;
-    o->angle = sp_cells_line_angle(o->v1[0], o->v1[1]);
-    o->Izz = o->Ixz = o->Iyz = o->I3 = 0.0;
-    o->v3[0] = o->v3[1] = o->v3[2] = 0.0;
+    *o = (sp_cell_obs){.mass = s[MASS], .mass_core = s[CORE], .volume = s[VOLUME]};
+    const double m = s[CORE] > 0 ? s[CORE] : 1.0;
+    for (int i = 0; i < dim; ++i) o->centre[i] = s[FIRST + i] / m;
+    /* central moments: int c Xb_i Xb_j = int c x_i x_j - m c_i c_j */
+    double M[3][3] = {{0}};
+    for (int i = 0, ij = SECOND; i < dim; ++i)
+      for (int j = i; j < dim; ++j, ++ij)
+        M[i][j] = M[j][i] = s[ij] - m * o->centre[i] * o->centre[j];
+    inertia(dim, M, o);
   }
   free(sums);
   return SP_OK;

@@ -54,24 +54,22 @@ int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *
  *         divisions.csv's of the division line). */
 double sp_cells_line_angle(double dx, double dy);
 
-/** @brief Principal moments and unit eigenvectors of a symmetric 2x2
- *         tensor, larger first (v1 is the larger moment's). */
-void sp_cells_principal(double Ixx, double Iyy, double Ixy, double *I1,
-                        double *I2, double v1[2], double v2[2]);
-
 /**
- * @brief Principal moments and unit eigenvectors of a symmetric 3x3 tensor
- *        (cyclic Jacobi), largest first: moments[0] >= moments[1] >=
- *        moments[2], v[i] the unit eigenvector of moments[i].
+ * @brief Principal moments and unit eigenvectors of a symmetric tensor's
+ *        leading @p dim x @p dim block (cyclic Jacobi), largest first:
+ *        moments[0] >= ... >= moments[dim - 1], v[i] the unit eigenvector
+ *        of moments[i]; entries beyond dim are 0.
  *
- * Well defined when two or three moments are equal (a sphere): the
- * eigenvectors are then an orthonormal basis of the degenerate space, never
- * NaN. Each v[i] is signed so that its component along a fixed generic
- * direction (cells.c) is >= 0: the same sign from runs that differ in
- * round-off, and for a vector in the xy plane the sign rule of
- * sp_cells_principal's v2.
+ * Well defined when moments are equal (a round cell): the eigenvectors are
+ * then an orthonormal basis of the degenerate space, never NaN. Each v[i]
+ * is signed so that its component along a fixed generic direction
+ * (cells.c) is >= 0: the same sign from runs that differ in round-off.
  */
-void sp_cells_principal3(const double tensor[3][3], double moments[3], double v[3][3]);
+void sp_cells_principal(int dim, const double tensor[3][3], double moments[3], double v[3][3]);
+
+/** @brief cells.csv's angle in 2D: of axes[0] (the line of a division's
+ *         cut) from the x axis, in (-pi/2, pi/2]; 0 in 3D. */
+double sp_cells_obs_angle(const sp_cell_obs *o, int dim);
 
 /**
  * @brief The initial fields of a scene (MODEL.md): cell k's profile p_k

@@ -35,7 +35,7 @@ int sp_division_params_check(const sp_division_params *params) {
 
 sp_cell_birth sp_cell_birth_make(double t, const sp_cell_obs *obs, int generation) {
   sp_cell_birth birth = {.birth_time = t, .birth_mass = obs->mass,
-                         .Iref = {obs->I1, obs->I2, obs->I3}, .generation = generation};
+                         .Iref = {obs->moments[0], obs->moments[1], obs->moments[2]}, .generation = generation};
   return birth;
 }
 
@@ -86,36 +86,21 @@ double sp_division_crossing_fraction(const sp_division_params *params,
   return theta < 0 ? 0.0 : theta > 1 ? 1.0 : theta;
 }
 
-void sp_division_axis(const sp_cell_obs *obs, double *px, double *py, double *dx,
-                      double *dy) {
-  *px = obs->xc;
-  *py = obs->yc;
-  *dx = obs->v1[0];
-  *dy = obs->v1[1];
-}
-
 void sp_division_plane(const sp_cell_obs *obs, int dim, double point[3], double normal[3]) {
-  point[0] = obs->xc;
-  point[1] = obs->yc;
-  point[2] = dim == 3 ? obs->zc : 0.0;
-  if (dim == 3) {
-    for (int d = 0; d < 3; ++d) normal[d] = obs->v3[d];
-    return;
+  for (int d = 0; d < 3; ++d) {
+    point[d] = d < dim ? obs->centre[d] : 0.0;
+    normal[d] = d < dim ? obs->axes[obs->long_axis][d] : 0.0;
   }
-  double px, py, dx, dy;
-  sp_division_axis(obs, &px, &py, &dx, &dy);
-  normal[0] = -dy; /* n = v2: v1 turned by +90 degrees */
-  normal[1] = dx;
-  normal[2] = 0.0;
 }
 
 /** Signed distance n . (X_i - P) of node i from the cut through P normal
- *  to n (2D: the line's, as written before 3D, so the same rounding). */
+ *  to n. */
 static double node_distance(const sp_mesh *mesh, int i, const double point[3],
                             const double normal[3]) {
   const double *x = mesh->xy + (size_t)mesh->dim * i;
-  const double in_plane = normal[0] * (x[0] - point[0]) + normal[1] * (x[1] - point[1]);
-  return mesh->dim == 3 ? in_plane + normal[2] * (x[2] - point[2]) : in_plane;
+  double sd = 0.0;
+  for (int d = 0; d < mesh->dim; ++d) sd += normal[d] * (x[d] - point[d]);
+  return sd;
 }
 
 double sp_division_child_share(double sd, int smooth, double width, double on_line) {

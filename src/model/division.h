@@ -165,32 +165,19 @@ double sp_division_crossing_fraction(const sp_division_params *params,
 double sp_division_child_share(double sd, int smooth, double width, double on_line);
 
 /**
- * @brief The division line of a cell in 2D: through its centre of mass
- *        along v1, the unit eigenvector of the LARGEST principal moment I1
- *        (MODEL.md); sp_division_plane gives the cut in either dimension.
- *
- * For an ellipse elongated along x, I1 = int c Xb1^2 is the larger moment and
- * v1 is the y axis: the cell is cut across its length.
- *
- * @param[in] obs the cell's observables (sp_cells_observe)
- * @param[out] px, py a point of the line (the centre of mass)
- * @param[out] dx, dy the line's unit direction (obs->v1)
- */
-void sp_division_axis(const sp_cell_obs *obs, double *px, double *py,
-                      double *dx, double *dy);
-
-/**
- * @brief The cut of a division in dimension @p dim: through the centre of
- *        mass Xc, normal to the cell's long axis.
+ * @brief The cut of a division: through the centre of mass Xc, normal to
+ *        the cell's long axis, in either dimension (a line in 2D, a plane
+ *        in 3D).
  *
  * The long axis is the unit eigenvector of the SMALLEST principal moment of
- * the inertia tensor (the direction of largest variance of c about Xc):
- * 2D: v2 = (-v1_y, v1_x), the normal of the line along v1 of
- * sp_division_axis (v1 is the LARGEST moment's, MODEL.md); 3D: v3, the
- * plane's normal. In 3D the largest moment does not name the cut: a
+ * the inertia tensor (the direction of largest variance of c about Xc;
+ * obs->axes[obs->long_axis]). In 2D the cut runs along the eigenvector of
+ * the LARGEST moment (docs/model.md): for an ellipse elongated along x
+ * the larger moment, int c Xb1^2, is about the y axis, so the cut runs
+ * along y, across the cell's length. In 3D the largest moment does not name the cut: a
  * prolate cell (a cigar) has I1 = I2, and a plane normal to any of their
- * eigenvectors would contain the long axis; the plane normal to v3 cuts it
- * across its length, as the 2D line does.
+ * eigenvectors would contain the long axis; the plane normal to the long
+ * axis cuts it across its length, as the 2D line does.
  *
  * @param[out] point Xc (2D: z = 0)
  * @param[out] normal the unit normal n (2D: n_z = 0)

@@ -162,13 +162,7 @@ void sp_lineage_obs_normal(const sp_cell_obs *obs, int dim, double normal[3]) {
 }
 
 void sp_lineage_set_obs_normal(sp_cell_obs *obs, const double normal[3]) {
-  for (int d = 0; d < 3; ++d) obs->v3[d] = normal[d]; /* (a 3D cut's normal) */
-  /* n = (-v1_y, v1_x): v1 = (n_y, -n_x); v2 is n */
-  obs->v1[0] = normal[1];
-  obs->v1[1] = -normal[0] + 0.0; /* (+0, not -0, in divisions.csv) */
-  obs->v2[0] = normal[0];
-  obs->v2[1] = normal[1];
-  obs->angle = sp_cells_line_angle(obs->v1[0], obs->v1[1]);
+  for (int d = 0; d < 3; ++d) obs->axes[obs->long_axis][d] = normal[d];
 }
 
 void sp_lineage_daughter_names(const sp_lineage_entry *e, const char *parent, sp_cell_name first,

@@ -99,10 +99,9 @@ void sp_lineage_normal(const sp_lineage_entry *e, int dim, const double long_axi
 
 /**
  * @brief The cut's geometry as division.h reads it from a cell's
- *        observables: the cut normal of @p obs (sp_division_plane's: in 2D
- *        v1 turned by +90 degrees, in 3D the long axis v3) into @p normal,
- *        and the converse, @p obs made to give @p normal (v1, v2 in 2D,
- *        v3 in 3D).
+ *        observables: the cut normal of @p obs (sp_division_plane's: the
+ *        long axis) into @p normal, and the converse, @p obs made to give
+ *        @p normal (its long axis set to it).
  */
 void sp_lineage_obs_normal(const sp_cell_obs *obs, int dim, double normal[3]);
 void sp_lineage_set_obs_normal(sp_cell_obs *obs, const double normal[3]);

@@ -34,11 +34,12 @@ int sp_shape_coefficients(int dim, int n_cells, const sp_cell_obs *obs,
     const sp_cell_obs *o = &obs[k];
     sp_shape_coef *s = &out[k];
     *s = (sp_shape_coef){.v = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-    const double I[3] = {o->I1, o->I2, o->I3};
-    const double *v[3] = {o->v1, o->v2, o->v3};
+    const double *I = o->moments;
+    const double(*v)[3] = o->axes;
     double trace = I[0] + I[1];
     if (dim == 3) trace += I[2];
-    int finite = isfinite(o->xc) && isfinite(o->yc) && isfinite(o->zc) && isfinite(trace);
+    int finite = isfinite(trace);
+    for (int d = 0; d < 3; ++d) finite = finite && isfinite(o->centre[d]);
     for (int i = 0; i < dim; ++i) {
       finite = finite && isfinite(birth[k].Iref[i]);
       for (int d = 0; d < 3; ++d) finite = finite && isfinite(v[i][d]);
@@ -47,27 +48,11 @@ int sp_shape_coefficients(int dim, int n_cells, const sp_cell_obs *obs,
     double c[3] = {0, 0, 0};
     for (int i = 0; i < dim; ++i)
       c[i] = delta[i] > 0 ? 2.0 * delta[i] * (birth[k].Iref[i] - I[i]) : 0.0;
-    s->xc = o->xc;
-    s->yc = o->yc;
-    s->zc = o->zc;
+    s->xc = o->centre[0];
+    s->yc = o->centre[1];
+    s->zc = o->centre[2];
     for (int i = 0; i < dim; ++i)
       for (int d = 0; d < 3; ++d) s->v[i][d] = v[i][d];
-    if (dim == 2) {
-      /* the n = 2 blend in closed form (the arithmetic of the 2D outputs):
-       * anisotropy e in [0, 1]; the deviatoric part fades out below the
-       * tolerance */
-      const double e = fmax(0.0, (I[0] - I[1]) / trace);
-      const double w = fmin(1.0, e / SP_SHAPE_ROUND_TOL);
-      const double mean = 0.5 * (c[0] + c[1]), half_diff = 0.5 * (c[0] - c[1]);
-      s->coef[0] = mean + w * half_diff;
-      s->coef[1] = mean - w * half_diff;
-      /* coef = W c with W = [[1+w, 1-w], [1-w, 1+w]] / 2 and dc_j/dI_j =
-       * -2 delta^j: gain = -dcoef/dI = W diag(2 delta) (w frozen) */
-      for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 2; ++j)
-          s->gain[i][j] = 0.5 * (i == j ? 1.0 + w : 1.0 - w) * 2.0 * delta[j];
-      continue;
-    }
     /* coef = W c, gain = W diag(2 delta) (W frozen) */
     double W[3][3];
     round_blend(dim, I, trace, W);
@@ -86,7 +71,7 @@ double sp_shape_energy(int n_cells, const sp_cell_obs *obs, const sp_cell_birth 
                        const double delta[3]) {
   double energy = 0.0;
   for (int k = 0; k < n_cells; ++k) {
-    const double I[3] = {obs[k].I1, obs[k].I2, obs[k].I3};
+    const double *I = obs[k].moments;
     for (int i = 0; i < 3; ++i)
       if (delta[i] > 0) {
         const double gap = birth[k].Iref[i] - I[i];

@@ -90,6 +90,31 @@ int sp_run_file_restart(const char *path, int n_set, const char *const *set,
  */
 void sp_run_request_stop(void);
 
+/** @brief The library's version, "MAJOR.MINOR" (0.2 here): the soname's. */
+const char *sp_version(void);
+
+/**
+ * @brief The mesh of the run whose step callback got @p info (valid during
+ *        that callback only; the same on every rank: each holds the whole
+ *        mesh). Any output pointer may be NULL.
+ * @param[out] coords n_nodes x dim coordinates, a node's together
+ * @param[out] elements nodes_per_element node ids (0-based) per element:
+ *        quadrilaterals in 2D, hexahedra in 3D, in the order of the VTU
+ *        files' connectivity
+ * @return SP_OK, or SP_ERR_INPUT for an @p info not from a callback
+ */
+int sp_step_mesh(const sp_step_info *info, int *dim, int *n_nodes, const double **coords,
+                 int *n_elements, int *nodes_per_element, const int **elements);
+
+/**
+ * @brief Cell @p cell's (0-based) field c after the step of @p info, on
+ *        every node of the mesh: @p c gets n_nodes values, 0 on the nodes
+ *        outside the cell's support (layout.support: local).
+ * @return SP_OK, or SP_ERR_INPUT for a cell out of range or an @p info not
+ *         from a callback
+ */
+int sp_step_cell_field(const sp_step_info *info, int cell, double *c);
+
 #ifdef __cplusplus
 }
 #endif

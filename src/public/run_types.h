@@ -86,6 +86,10 @@ typedef struct {
   const sp_cell_obs *cells; /**< n_cells observables of the new state */
   double wall_seconds;   /**< since the run began */
   int last;              /**< 1 on the run's last step (t_end or max_steps) */
+  int dim;               /**< the mesh's dimension, 2 or 3 */
+  const sp_cell_name *names; /**< n_cells names ("" for an unnamed cell) */
+  const void *run;       /**< the run, for sp_step_mesh and sp_step_cell_field
+                              (opaque; valid during the callback only) */
 } sp_step_info;
 
 /** Called after every accepted step (and its output) on every rank; a

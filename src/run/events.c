@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "base/agree.h"
 #include "model/cells.h"
 #include "model/division.h"
 #include "public/error.h"
@@ -14,6 +15,7 @@
 #include "run/resize.h"
 #include "run/run_energy.h"
 #include "model/source.h"
+#include "run/stop.h"
 #include "model/support.h"
 #include "time/time_scheme.h"
 #include "base/wall_clock.h"
@@ -27,13 +29,14 @@ double sp_events_next(const sp_run *run, double t) {
     event = fmin(event, k * every);
   }
   if (!run->opt.time.adaptive) return event;
-  const int by_age = run->opt.division.criterion == SP_DIVIDE_BY_AGE &&
+  const sp_run_division *dv = &run->opt.division;
+  const int by_age = dv->divides && dv->rule.criterion == SP_DIVIDE_AGE &&
                      run->layout->n_cells < run->n_max;
   for (int k = 0; k < run->layout->n_cells; ++k) {
     const sp_lineage_entry *e = sp_lineage_find(&run->lineage, run->cells.name[k]);
     if (!e && !by_age) continue;
     const double due = e ? sp_lineage_due_time(e, &run->cells.birth[k])
-                         : run->cells.birth[k].birth_time + run->opt.division.t_div;
+                         : run->cells.birth[k].birth_time + dv->rule.age;
     if (due > t + slack) event = fmin(event, due);
   }
   return event;
@@ -53,11 +56,26 @@ double sp_events_first_dt(const sp_run *run) {
   return fmax(dt, p->dt_min);
 }
 
+int sp_events_checkpoint_due(const sp_run *run, int *due, int *signalled) {
+  const sp_run_output *o = &run->opt.output;
+  /* a signal may reach one rank only, and the clocks differ: agreed */
+  int want_stop = sp_stop_requested();
+  int want_time = o->checkpoint_seconds > 0 &&
+                  sp_wall_clock() - run->mon.t_checkpoint >= o->checkpoint_seconds;
+  SP_CALL(sp_agree_any(run->agree_comm, &want_stop));
+  SP_CALL(sp_agree_any(run->agree_comm, &want_time));
+  *signalled = want_stop;
+  *due = want_stop || want_time ||
+         (o->checkpoint_every > 0 && run->step % o->checkpoint_every == 0);
+  return SP_OK;
+}
+
 int sp_events_landing(sp_run *run, double t, double dt, int *observed, double *theta) {
   *theta = 1.0;
   const sp_registry *cells = &run->cells;
   const int n_cells = run->layout->n_cells;
-  const int by_mass = run->opt.division.criterion == SP_DIVIDE_BY_MASS && n_cells < run->n_max;
+  const sp_run_division *dv = &run->opt.division;
+  const int by_mass = dv->divides && dv->rule.criterion == SP_DIVIDE_MASS && n_cells < run->n_max;
   int lineage_mass = 0;
   for (int i = 0; i < run->lineage.n; ++i)
     lineage_mass |= run->lineage.entry[i].when == SP_LINEAGE_MASS;
@@ -69,7 +87,7 @@ int sp_events_landing(sp_run *run, double t, double dt, int *observed, double *t
     const sp_lineage_entry *e = sp_lineage_find(&run->lineage, cells->name[k]);
     if (e ? e->when != SP_LINEAGE_MASS : !by_mass) continue;
     const sp_division_params p =
-        e ? sp_lineage_params(e, &cells->birth[k], run->division.tolerance) : run->division;
+        e ? sp_lineage_params(e, &cells->birth[k], dv->rule.tolerance) : dv->rule;
     const double m_old = cells->obs[k].mass_core, m_new = cells->obs_new[k].mass_core;
     if (!sp_division_due(&p, &cells->birth[k], t, t + dt, m_old, m_new)) continue;
     const double f = sp_division_crossing_fraction(&p, &cells->birth[k], t, t + dt, m_old, m_new);
@@ -198,8 +216,11 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
   sp_lineage_daughter_names(e, parent_name, cells->name[parent], cells->name[child]);
   memcpy(cells->cut_normal[parent], normal, sizeof normal);
   memcpy(cells->cut_normal[child], normal, sizeof normal);
-  /* (2D: the angle of v1, the division line, as the observables have it) */
-  *record = (sp_division_record){.parent = parent, .child = child, .angle = parent_obs.angle,
+  const int dim = run->mesh->dim;
+  /* 2D: the angle of the division line, the normal turned by -90 degrees
+   * (+0, not -0, in divisions.csv) */
+  const double angle = dim == 2 ? sp_cells_line_angle(normal[1], -normal[0] + 0.0) : 0.0;
+  *record = (sp_division_record){.parent = parent, .child = child, .angle = angle,
                                  .parent_mass = parent_obs.mass,
                                  .mass_a = cells->obs[parent].mass,
                                  .mass_b = cells->obs[child].mass,
@@ -217,15 +238,16 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
  *  step). N_max limits the scene's divisions only: the table is a schedule. */
 static int divide_due_cells(sp_run *run, double t_old, int *n_divided) {
   *n_divided = 0;
-  const int by_rule = run->opt.division.criterion != SP_DIVIDE_NONE;
+  const sp_run_division *dv = &run->opt.division;
+  const int by_rule = dv->divides;
   if (!by_rule && run->lineage.n == 0) return SP_OK;
   const int n = run->layout->n_cells;
   for (int k = 0; k < n; ++k) {
     sp_registry *cells = &run->cells;
     const sp_lineage_entry *e = sp_lineage_find(&run->lineage, cells->name[k]);
     if (e ? !sp_lineage_due(e, &cells->birth[k], run->t, cells->obs[k].mass_core,
-                            run->division.tolerance)
-          : !by_rule || !sp_division_due(&run->division, &cells->birth[k], t_old, run->t,
+                            dv->rule.tolerance)
+          : !by_rule || !sp_division_due(&dv->rule, &cells->birth[k], t_old, run->t,
                                          cells->core_mass_old[k], cells->obs[k].mass_core))
       continue;
     if (!e && run->layout->n_cells >= run->n_max) {

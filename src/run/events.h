@@ -50,6 +50,12 @@ double sp_events_first_dt(const sp_run *run);
 /** @brief 1 if @p t is a multiple of output.interval (to round-off). */
 int sp_events_on_output_time(const sp_run *run, double t);
 
+/** @brief Whether a checkpoint is due after the step just completed
+ *         (output.checkpoint_every, output.checkpoint_seconds since the
+ *         last one, or a stop request: @p signalled), agreed by every
+ *         rank. Collective. */
+int sp_events_checkpoint_due(const sp_run *run, int *due, int *signalled);
+
 /** @brief Adaptive control, mass criterion, N < N_max: the observables of
  *         the end of the step from @p t of @p dt (the run's state; into
  *         run->cells.obs_new, *observed = 1) and the fraction @p theta of

@@ -146,6 +146,17 @@ static int write_snapshot(sp_run *run) {
                           mon->n_divisions, path);
 }
 
+/** The run ends with the error @p rc of a step that gave up: the last good
+ *  state written, and the message says so (or why it could not be). */
+static int write_last_state(sp_run *run, int rc) {
+  char why[1024];
+  snprintf(why, sizeof why, "%s", sp_error_message());
+  if (write_snapshot(run) == SP_OK)
+    return sp_error_set(rc, "%s. The last good state (t = %.6g) is written.", why, run->t);
+  return sp_error_set(rc, "%s. Writing the last good state (t = %.6g) failed: %s", why, run->t,
+                      sp_error_message());
+}
+
 int sp_monitor_open(sp_run *run) {
   sp_monitor *mon = &run->mon;
   int rc = SP_OK;
@@ -235,31 +246,15 @@ int sp_monitor_attempt(sp_run *run, const sp_step_attempt *a, int rc) {
   costs->assembly += a->report.t_assembly;
   costs->factorisation += a->report.t_factor;
   costs->solves += a->report.t_solve;
-  if (rc != SP_OK || a->verdict == SP_STEP_ACCEPTED || a->verdict == SP_STEP_INTERRUPTED)
+  if ((rc != SP_OK && !a->give_up) || a->verdict == SP_STEP_ACCEPTED ||
+      a->verdict == SP_STEP_INTERRUPTED)
     return rc;
   SP_CALL(record_attempt(mon, a, run->dtc.dt_next));
   ++sum->failed_attempts;
   costs->failed_factorisations += a->report.factorisations;
   sum->failed_factorisations += a->report.factorisations;
   report_failure(run, a);
-  if (!a->give_up) return SP_OK;
-  const int rc_out = write_snapshot(run);
-  const sp_dt_params *p = &run->opt.time.dt;
-  if (a->verdict == SP_STEP_NEWTON_FAILED && a->report.failure == SP_NEWTON_OUT_OF_MEMORY)
-    return sp_error_set(SP_ERR_MEMORY,
-                        "step %d at t = %.6g: %s. A smaller step has a matrix of the same size, "
-                        "so it is not retried; solver.linear gmres_cells or gmres_ilu need less "
-                        "memory than a direct solver in 3D, and mumps or superlu_dist on more "
-                        "processes split the factors (docs/3d.md). The last good state "
-                        "(t = %.6g) is written%s.",
-                        run->step + 1, run->t, a->why, run->t,
-                        rc_out == SP_OK ? "" : " (failed: see above)");
-  return sp_error_set(SP_ERR_SOLVER,
-                      "step %d at t = %.6g failed %d attempts "
-                      "(last dt = %.3g; time.max_retries = %d, time.dt_min = %.3g): %s. "
-                      "The last good state (t = %.6g) is written%s.",
-                      run->step + 1, run->t, run->dtc.failures, a->dt, p->max_retries,
-                      p->dt_min, a->why, run->t, rc_out == SP_OK ? "" : " (failed: see above)");
+  return a->give_up ? write_last_state(run, rc) : SP_OK;
 }
 
 /** The divisions of the step: their rows of divisions.csv, their times on
@@ -320,18 +315,11 @@ static void forget_step(sp_monitor *mon) {
  *  or a stop was requested on any rank (*signalled = 1). All ranks decide
  *  alike; rank 0 writes. */
 static int checkpoint_if_due(sp_run *run, int *signalled) {
-  const sp_run_output *o = &run->opt.output;
   sp_monitor *mon = &run->mon;
-  /* a signal may reach one rank only, and the clocks differ: agreed */
-  int want_stop = sp_stop_requested(); /* (stop.h) */
-  int want_time = o->checkpoint_seconds > 0 &&
-                  sp_wall_clock() - mon->t_checkpoint >= o->checkpoint_seconds;
-  SP_CALL(sp_agree_any(run->agree_comm, &want_stop));
-  SP_CALL(sp_agree_any(run->agree_comm, &want_time));
-  *signalled = want_stop;
-  if (!(want_stop || want_time ||
-        (o->checkpoint_every > 0 && run->step % o->checkpoint_every == 0)))
-    return SP_OK;
+  int due;
+  SP_CALL(sp_events_checkpoint_due(run, &due, signalled));
+  const int want_stop = *signalled;
+  if (!due) return SP_OK;
   char path[4096] = "";
   const double t0 = sp_wall_clock();
   int rc = SP_OK;
@@ -362,7 +350,9 @@ static int call_back(sp_run *run, const sp_step_attempt *a, int failed, int ends
                              .newton_its = a->report.newton_its, .failed_attempts = failed,
                              .attempts = mon->attempts, .error_estimate = a->err,
                              .cells = run->cells.obs,
-                             .wall_seconds = sp_wall_clock() - mon->t_start, .last = ends};
+                             .wall_seconds = sp_wall_clock() - mon->t_start, .last = ends,
+                             .dim = run->mesh->dim, .names = (const sp_cell_name *)run->cells.name,
+                             .run = run};
   *stop = mon->on_step(&info, mon->on_step_user) != 0;
   SP_CALL(sp_agree_any(run->agree_comm, stop)); /* any rank's stop stops every rank */
   mon->sum->stopped = *stop ? SP_STOPPED_CALLBACK : 0;

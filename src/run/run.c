@@ -108,3 +108,36 @@ int sp_run_file_restart(const char *path, int n_set, const char *const *set,
 }
 
 void sp_run_request_stop(void) { sp_stop_request(); }
+
+/** The run of a step callback's @p info (NULL: not from a callback). */
+static const sp_run *callback_run(const sp_step_info *info) {
+  return info ? (const sp_run *)info->run : NULL;
+}
+
+int sp_step_mesh(const sp_step_info *info, int *dim, int *n_nodes, const double **coords,
+                 int *n_elements, int *nodes_per_element, const int **elements) {
+  const sp_run *run = callback_run(info);
+  SP_CHECK(run && run->mesh, SP_ERR_INPUT, "sp_step_mesh: not called with a step callback's info");
+  const sp_mesh *m = run->mesh;
+  if (dim) *dim = m->dim;
+  if (n_nodes) *n_nodes = m->n_nodes;
+  if (coords) *coords = m->xy;
+  if (n_elements) *n_elements = m->n_elems;
+  if (nodes_per_element) *nodes_per_element = m->nodes_per_elem;
+  if (elements) *elements = m->elem;
+  return SP_OK;
+}
+
+int sp_step_cell_field(const sp_step_info *info, int cell, double *c) {
+  const sp_run *run = callback_run(info);
+  SP_CHECK(run && run->layout && run->state, SP_ERR_INPUT,
+           "sp_step_cell_field: not called with a step callback's info");
+  SP_CHECK(cell >= 0 && cell < run->layout->n_cells, SP_ERR_INPUT,
+           "sp_step_cell_field: cell %d, the run has cells 0 to %d", cell,
+           run->layout->n_cells - 1);
+  for (int i = 0; i < run->layout->n_nodes; ++i) {
+    const int p = sp_layout_pair(run->layout, cell, i);
+    c[i] = p >= 0 ? run->state[2 * p] : 0.0;
+  }
+  return SP_OK;
+}

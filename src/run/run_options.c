@@ -1,4 +1,4 @@
-/* The one reader of the scene for a run (run_options.h). */
+/* The run's options from the scene (run_options.h). */
 #include "run/run_options.h"
 
 #include <string.h>
@@ -87,7 +87,13 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
   opt->time.t_end = tc->t_end;
   opt->time.max_steps = tc->max_steps;
   opt->time.predictor_linear = scene->solver.predictor == SP_PREDICT_LINEAR;
-  opt->division = (sp_run_division){.criterion = dv->criterion, .t_div = dv->t_div,
+  opt->division = (sp_run_division){.divides = dv->criterion != SP_DIVIDE_NONE,
+                                    .rule = {.criterion = dv->criterion == SP_DIVIDE_BY_AGE
+                                                              ? SP_DIVIDE_AGE
+                                                              : SP_DIVIDE_MASS,
+                                             .age = dv->t_div,
+                                             .mass_ratio = dv->mass_ratio},
+                                    .reference_initial = dv->use_initial_mass,
                                     .smooth_cut = dv->cut == SP_CUT_SMOOTH,
                                     .equal_mass_line = dv->line == SP_LINE_EQUAL_MASS,
                                     .observe_threshold = dv->observe_threshold,

@@ -1,8 +1,8 @@
 /**
  * @file run_options.h
- * @brief The one reader of the scene for a run: the scene is resolved once,
- *        at set-up, into these options; nothing after set-up reads the
- *        scene (sp_scene) itself. Each part goes to the module that uses
+ * @brief The run's options: the scene's settings resolved once, at
+ *        set-up (sp_run_setup builds the run's objects from the scene and
+ *        these); nothing after set-up reads the scene (sp_scene) itself. Each part goes to the module that uses
  *        it: the solver's options and the model to the glue, the
  *        controller's parameters to dt_control.h, the division rule to
  *        division.h, the rest to the step, the events and the monitor.
@@ -10,6 +10,7 @@
 #ifndef SP_RUN_OPTIONS_H
 #define SP_RUN_OPTIONS_H
 
+#include "model/division.h"
 #include "time/dt_control.h"
 #include "mesh/mesh.h"
 #include "io/output.h"
@@ -32,10 +33,14 @@ typedef struct {
   int predictor_linear;   /**< solver.predictor: linear */
 } sp_run_time;
 
-/** Divisions (division.*) as the events and the cut use them. */
+/** Divisions (division.*) as the events and the cut use them: the one
+ *  division configuration of a run. */
 typedef struct {
-  sp_division_kind criterion; /**< none | age | mass */
-  double t_div;               /**< age criterion: the age */
+  int divides;                /**< division.criterion is not none */
+  sp_division_params rule;    /**< the criterion (division.h); its reference
+                                   mass and landing tolerance are set with the
+                                   initial cells (sp_run_setup) */
+  int reference_initial;      /**< division.use_initial_mass */
   int smooth_cut;             /**< division.cut: smooth */
   int equal_mass_line;        /**< division.line: equal_mass */
   double observe_threshold;   /**< the observables' threshold on c */

@@ -1,6 +1,8 @@
 /* The run's set-up (run_setup.h): everything a run is before its first
  * step, built in one place for the run, check-jacobian, the benchmarks and
- * the tests; the only reader of the scene. */
+ * the tests. The scene's settings reach the run as its options
+ * (run_options.h); set-up reads the scene only for the objects it builds
+ * (the mesh, the initial fields and cells, the supports). */
 #include "run/run_setup.h"
 
 #include <stdlib.h>
@@ -190,12 +192,9 @@ static int setup(sp_run *run, const sp_scene *scene, MPI_Comm comm, const sp_run
   /* (With local supports the solver sees only the local layout: the full
    * one's graph couples every pair of cells at every node, N^2 x nodes
    * entries, 20 GB for 256 cells on 84k nodes.) */
-  const sp_scene_division *dv = &scene->division;
-  run->division = (sp_division_params){
-      .criterion = dv->criterion == SP_DIVIDE_BY_AGE ? SP_DIVIDE_AGE : SP_DIVIDE_MASS,
-      .age = dv->t_div, .mass_ratio = dv->mass_ratio,
-      .reference_mass = dv->use_initial_mass ? reference_mass : 0.0,
-      .tolerance = run->opt.time.adaptive ? SP_MASS_LANDING_TOLERANCE : 0.0};
+  sp_run_division *dv = &run->opt.division;
+  dv->rule.reference_mass = dv->reference_initial ? reference_mass : 0.0;
+  dv->rule.tolerance = run->opt.time.adaptive ? SP_MASS_LANDING_TOLERANCE : 0.0;
   return SP_OK;
 }
 

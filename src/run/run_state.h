@@ -104,11 +104,8 @@ typedef struct {
                                      signal goes back to it) */
   int marked_step;      /**< the step whose start dtc_step_start and the
                              solver's carry mark hold (0: none yet) */
-  int attempt;          /**< attempts of the step in progress so far */
-  int polls;            /**< stop polls in the attempt in progress */
   sp_registry cells;    /**< the cell registry */
   int n_max;            /**< N_max */
-  sp_division_params division; /**< the division criterion */
   sp_lineage lineage;   /**< the lineage table (lineage.h; from the scene) */
   int restarted;        /**< 1: continued from a checkpoint (not as initial) */
   /* scratch of a step */

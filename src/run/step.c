@@ -150,19 +150,37 @@ static int judge(sp_run *run, sp_scheme_kind kind, int solved, sp_step_attempt *
   return SP_OK;
 }
 
+/** The error that ends a run whose step @p a failed and will not be
+ *  retried: out of memory (a smaller step has a matrix of the same size),
+ *  or the retries spent. */
+static int gave_up(const sp_run *run, const sp_step_attempt *a) {
+  const sp_dt_params *p = &run->opt.time.dt;
+  if (a->verdict == SP_STEP_NEWTON_FAILED && a->report.failure == SP_NEWTON_OUT_OF_MEMORY)
+    return sp_error_set(SP_ERR_MEMORY,
+                        "step %d at t = %.6g: %s. A smaller step has a matrix of the same size, "
+                        "so it is not retried; solver.linear gmres_cells or gmres_ilu need less "
+                        "memory than a direct solver in 3D, and mumps or superlu_dist on more "
+                        "processes split the factors (docs/3d.md)",
+                        run->step + 1, run->t, a->why);
+  return sp_error_set(SP_ERR_SOLVER,
+                      "step %d at t = %.6g failed %d attempts "
+                      "(last dt = %.3g; time.max_retries = %d, time.dt_min = %.3g): %s",
+                      run->step + 1, run->t, run->dtc.failures, a->dt, p->max_retries,
+                      p->dt_min, a->why);
+}
+
 int sp_step_try(sp_run *run, sp_step_attempt *a) {
   *a = (sp_step_attempt){.verdict = SP_STEP_FATAL, .wall_start = sp_wall_clock(), .t = run->t,
                          .err = -1.0};
   const size_t n_pairs = (size_t)run->layout->n_pairs, n_values = 2 * n_pairs;
-  if (run->marked_step != run->step + 1) { /* the step's first attempt */
+  const int first_attempt = run->marked_step != run->step + 1;
+  if (first_attempt) {
     run->dtc_step_start = run->dtc;
     run->marked_step = run->step + 1;
-    run->attempt = 0;
     const int rc = sp_solver_carry_mark(run->solver);
     if (rc != SP_SOLVER_OK) return sp_solver_failed(run->solver, rc, "step %d", run->step + 1);
   }
-  ++run->attempt;
-  run->polls = 0;
+  sp_fault_attempt_begin(run->step + 1, first_attempt);
   const double t_event = sp_events_next(run, run->t);
   a->dt = sp_dt_propose(&run->dtc, run->t, t_event, &a->lands);
   a->t_new = a->lands ? t_event : run->t + a->dt;
@@ -181,7 +199,7 @@ int sp_step_try(sp_run *run, sp_step_attempt *a) {
   SP_CALL(judge(run, kind, solved, a));
   if (a->verdict != SP_STEP_ACCEPTED) /* retried from the last good state */
     memcpy(run->state, run->buf.state_old, n_values * sizeof(double));
-  return SP_OK;
+  return a->give_up ? gave_up(run, a) : SP_OK;
 }
 
 int sp_step_complete(sp_run *run, const sp_step_attempt *a) {

@@ -50,8 +50,9 @@ typedef struct {
   int lands;        /**< 1: t_new is an event (t_end, output, age division) */
   double err;       /**< error estimate over its tolerance (-1: none) */
   int observed;     /**< run->cells.obs_new holds the observables of its end */
-  int give_up;      /**< not accepted and the controller gives up (the run
-                         ends with the last good state) */
+  int give_up;      /**< not accepted and not to be retried: sp_step_try
+                         returned the error that ends the run (the last
+                         good state is still the run's) */
   sp_step_report report; /**< Newton's (its costs, |F| history, failure) */
   const char *why;  /**< not accepted: why, in words */
   char why_text[160];
@@ -59,8 +60,11 @@ typedef struct {
 
 /**
  * @brief Attempt the next step of @p run. Collective.
- * @return SP_OK with a->verdict set, or an error code (a->verdict
- *         SP_STEP_FATAL: a hard solver error, a failed allocation, a fault)
+ * @return SP_OK with a->verdict set; or the error that ends the run with
+ *         the verdict of an attempt not to be retried (a->give_up: the
+ *         retries spent, SP_ERR_SOLVER; the factors out of memory,
+ *         SP_ERR_MEMORY); or another error code (a->verdict SP_STEP_FATAL:
+ *         a hard solver error, a failed allocation, a fault)
  */
 int sp_step_try(sp_run *run, sp_step_attempt *a);
 

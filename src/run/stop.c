@@ -17,8 +17,7 @@ void sp_stop_clear(void) { atomic_store(&stop_requested, 0); }
 
 int sp_stop_poll(void *ctx) {
   sp_run *run = ctx;
-  if (++run->polls == 2 && sp_fault_interrupt_due(run->rank, run->step + 1, run->attempt))
-    sp_stop_request();
+  if (sp_fault_interrupt_poll(run->rank)) sp_stop_request();
   int want_stop = sp_stop_requested();
   return sp_agree_any(run->agree_comm, &want_stop) != SP_OK || want_stop;
 }
