@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Per-step cost of two softpack binaries on one scene (issue 31: the
+# Per-step cost of two softpack binaries on one scene (the
 # Newton solve on NOX-Epetra, then on NOX-Thyra): ROUNDS rounds, each
 # running OLD and NEW at the same time (one process each: on a machine
 # shared with other work both see the same load at the same moments).
