@@ -26,8 +26,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "error.h"
-#include "run_setup.h"
+#include "public/error.h"
+#include "run/run_setup.h"
 #include "softpack_solver.h"
 
 /** A scene of @p n disks on a sunflower spiral inside the ellipse (semi-axes

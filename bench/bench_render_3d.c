@@ -12,11 +12,11 @@
 #include <stdlib.h>
 #include <sys/stat.h>
 
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
-#include "render.h"
-#include "wall_clock.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "io/render.h"
+#include "base/wall_clock.h"
 
 #define N_CELLS 8
 

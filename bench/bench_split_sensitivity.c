@@ -25,14 +25,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
-#include "division.h"
-#include "error.h"
-#include "initial.h"
-#include "layout.h"
-#include "mesh.h"
-#include "scene.h"
-#include "stepper.h"
+#include "model/cells.h"
+#include "model/division.h"
+#include "public/error.h"
+#include "io/initial.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 /** The scene's text without its cells, starting from @p vtu instead. */
 static char *scene_from_vtu(const char *scene_path, const char *vtu) {
@@ -89,9 +89,9 @@ int main(int argc, char **argv) {
     fprintf(stderr, "bench_split_sensitivity: %s\n", sp_error_message());
     return 1;
   }
-  double px, py, dx, dy;
-  sp_division_axis(&obs, &px, &py, &dx, &dy);
-  const double nx = -dy, ny = dx, on_line = SP_DIVISION_ON_LINE_FRACTION * mesh->h;
+  double point[3], normal[3];
+  sp_division_plane(&obs, 2, point, normal);
+  const double px = point[0], py = point[1], nx = normal[0], ny = normal[1], on_line = SP_DIVISION_ON_LINE_FRACTION * mesh->h;
   const double width = sp_scene_interface_width(scene);
   for (int i = 0; i < nn; ++i)
     sd[i] = nx * (mesh->xy[2 * i] - px) + ny * (mesh->xy[2 * i + 1] - py);
@@ -101,7 +101,7 @@ int main(int argc, char **argv) {
       m0[s] += w[i] * parent[2 * i] * sp_division_child_share(sd[i], s, width, on_line);
   printf("%s, %s: parent = cells %d + %d, mass %.8f, centre (%.4e, %.4e), axis angle %.8f "
          "(pi/2 %+.3e), mesh h %.4g; child mass at the line: sharp %.8f, smooth %.8f\n",
-         argv[1], argv[2], a + 1, b + 1, obs.mass, px, py, obs.angle, obs.angle - M_PI / 2,
+         argv[1], argv[2], a + 1, b + 1, obs.mass, px, py, sp_cells_obs_angle(&obs, 2), sp_cells_obs_angle(&obs, 2) - M_PI / 2,
          mesh->h, m0[0], m0[1]);
   printf("\n| offset s | nodes within s of the line (c >= 1/2) | sharp: M(s) - M(0) | relative "
          "| M(-s) - M(0) | smooth: M(s) - M(0) | relative |\n|---|---|---|---|---|---|---|\n");

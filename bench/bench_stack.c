@@ -17,14 +17,14 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "cells.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
-#include "q1.h"
+#include "model/cells.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 #include "softpack_solver.h"
-#include "resize.h"
-#include "stepper.h"
+#include "run/resize.h"
+#include "run/stepper.h"
 
 #define N_CELLS 3
 
@@ -48,7 +48,7 @@ static result run(int n, int steps, double dt) {
     fprintf(stderr, "setup failed\n");
     exit(1);
   }
-  sp_solver_options opt = {.jacobian = SP_SOLVER_JAC_AD, .linear = SP_SOLVER_SUPERLU,
+  sp_solver_options opt = {.jacobian = SP_SOLVER_JAC_AD, .linear = SP_LINEAR_SUPERLU,
                            .newton_rtol = 1e-8, .newton_atol = 1e-10, .newton_max_its = 12};
   sp_solver s;
   if (sp_solver_create(MPI_COMM_WORLD, &opt, &s) || sp_solver_attach(s, mesh, layout)) {

@@ -6,7 +6,7 @@
  * catches every exception and returns a code (sp_solver_status: the class of
  * the error); the message is kept in the handle (sp_solver_last_error).
  *
- * The unknowns follow a layout (src/layout.h): pairs (cell, node), numbered
+ * The unknowns follow a layout (src/mesh/layout.h): pairs (cell, node), numbered
  * node-major, two unknowns per pair: state[2p] = c, state[2p+1] = mu.
  */
 #ifndef SOFTPACK_SOLVER_H
@@ -15,6 +15,7 @@
 #include <mpi.h>
 #include <stdint.h>
 
+#include "softpack_linear.h"
 #include "softpack_newton.h"
 
 #ifdef __cplusplus
@@ -24,7 +25,7 @@ extern "C" {
 /**
  * What every entry point returns: 0, Newton's failure to converge
  * (sp_solver_step only: retry with a smaller dt), or the class of a hard
- * error. The C core maps the classes to its own codes (src/solver_status.h)
+ * error. The C core maps the classes to its own codes (src/run/solver_status.h)
  * and so to exit statuses: only SP_SOLVER_ERR_INPUT is bad input (exit 2),
  * every other class exits 1 (docs/robustness.md).
  */
@@ -52,18 +53,6 @@ enum {
   SP_SOLVER_JAC_FD = 2,
   SP_SOLVER_JAC_AD_DFAD = 3
 };
-/** Linear solver of each Newton iteration: direct, or GMRES preconditioned
- *  by ILU(k) (additive Schwarz, one ILU per rank, under MPI). KLU2 is
- *  Amesos2's (one process only), KLU Amesos (v1)'s. */
-enum {
-  SP_SOLVER_SUPERLU = 0,
-  SP_SOLVER_SUPERLU_DIST = 1,
-  SP_SOLVER_MUMPS = 2,
-  SP_SOLVER_KLU2 = 3,
-  SP_SOLVER_GMRES_ILU = 4,
-  SP_SOLVER_KLU = 5,
-  SP_SOLVER_GMRES_CELLS = 6 /**< GMRES on the cells' diagonal blocks (MUMPS) */
-};
 /** SuperLU_DIST's fill-reducing column order: METIS on the graph of the
  *  (cell, node) pairs (c and mu of a pair together), or on the unknowns
  *  (SuperLU_DIST's own METIS_AT_PLUS_A). */
@@ -77,7 +66,7 @@ typedef struct sp_solver_s *sp_solver;
 
 typedef struct {
   int jacobian;        /**< SP_SOLVER_JAC_* */
-  int linear;          /**< SP_SOLVER_SUPERLU, ... */
+  int linear;          /**< sp_linear_kind (softpack_linear.h), not auto */
   double newton_rtol;  /**< ||F|| <= rtol ||F_0|| ... */
   double newton_atol;  /**< ... or ||F|| <= atol (unscaled 2-norm) */
   int newton_max_its;  /**< more iterations count as a failure */
@@ -102,7 +91,7 @@ typedef struct {
   /** SuperLU_DIST only: 1 for one step of iterative refinement per solve
    *  (SuperLU_DIST's default), 0 for none. */
   int refine;
-  /** SP_SOLVER_GMRES_ILU only, taken as given (no defaults here: the
+  /** SP_LINEAR_GMRES_ILU only, taken as given (no defaults here: the
    *  scene's solver.ilu_fill and solver.krylov_tol have them): the ILU(k)
    *  level of fill, >= 0 (0: ILU(0)), and the relative residual of a
    *  linear solve, in (0, 1). */
@@ -112,7 +101,7 @@ typedef struct {
 
 /** The mesh, borrowed (must outlive the solver's use of it): Q1
  *  quadrilaterals (dim 2, 4 nodes per element) or hexahedra (dim 3, 8),
- *  nodes in the order of src/q1.h. */
+ *  nodes in the order of src/mesh/q1.h. */
 typedef struct {
   int n_nodes, n_elems;
   const double *xy;       /**< dim * n_nodes */
@@ -132,7 +121,7 @@ typedef struct {
    *  communicator size). NULL: equal node counts per rank. */
   const int *rank_first_node;
   int n_ranks;
-  /** The element-slot table (src/layout.h, sp_slots; required): element
+  /** The element-slot table (src/mesh/layout.h, sp_slots; required): element
    *  e's cells are slot_cell[elem_start[e] .. elem_start[e+1]-1], by
    *  increasing cell, each with the pairs of the element's nodes at
    *  slot_pair[n s .. n s + n - 1], n = the mesh's nodes_per_elem. The C
@@ -153,7 +142,7 @@ typedef struct {
  * Shape-penalty data of one cell (MODEL.md, shape penalty): the term adds
  * -sum_i coef_i * (v_i . Ibar(X) v_i) to mu_k, Ibar about the centre (xc,
  * yc[, zc]), i over the mesh's dim principal moments (2 in 2D, 3 in 3D;
- * Ibar = |Xb|^2 Id - Xb Xb^T, src/shape.h). Entries beyond dim are unused.
+ * Ibar = |Xb|^2 Id - Xb Xb^T, src/model/shape.h). Entries beyond dim are unused.
  *
  * Explicit (sp_step_data.shape_implicit = 0): coef as given, from c^n.
  * Linearised implicit (shape_implicit = 1): with the centre, eigenvectors
@@ -168,7 +157,7 @@ typedef struct {
   double xc, yc;
   double zc;       /**< 3D: the centre's z (0 in 2D) */
   double v[3][3];  /**< unit eigenvectors v_1 (largest moment), v_2 (, v_3) */
-  double coef[3];  /**< 2 delta^i (I^i,ref - I^i) (round cells: src/shape.h) */
+  double coef[3];  /**< 2 delta^i (I^i,ref - I^i) (round cells: src/model/shape.h) */
   double gain[3][3]; /**< -d coef_i / d I_j (implicit only; 0: none) */
   double threshold; /**< the term acts only where c^n >= threshold (at the
                          quadrature point), as the observables count c only
@@ -343,7 +332,7 @@ const char *sp_solver_trilinos_version(void);
 
 /**
  * @brief What serves a linear solver in this build (softpack info).
- * @param[in] linear SP_SOLVER_SUPERLU, ...
+ * @param[in] linear SP_LINEAR_SUPERLU, ...
  * @param[out] backend the library behind it and its version, e.g.
  *             "SuperLU 5.3.0 (dgstrf)" (static text; NULL: not wanted)
  * @return 1 if this build can use it, 0 if not (an Amesos built without

@@ -7,9 +7,9 @@
 
 #include <Trilinos_version.h>
 
-#include "errors.hpp"
-#include "fault.h"
-#include "linear.hpp"
+#include "base/errors.hpp"
+#include "base/fault.h"
+#include "linear/linear.hpp"
 #include "newton.hpp"
 #include "softpack_solver.h"
 
@@ -49,27 +49,7 @@ extern "C" {
 const char *sp_solver_trilinos_version(void) { return TRILINOS_VERSION_STRING; }
 
 int sp_solver_linear_backend(int linear, const char **backend) {
-  const char *what = nullptr;
-  int available = 1;
-  try {
-    switch (linear) {
-      case SP_SOLVER_SUPERLU: what = sp::superlu_version(); break;
-      case SP_SOLVER_SUPERLU_DIST: what = sp::superlu_dist_version(); break;
-      case SP_SOLVER_MUMPS: what = sp::mumps_version(); break;
-      case SP_SOLVER_KLU: what = sp::klu_version(); break;
-      case SP_SOLVER_KLU2:
-        what = sp::amesos2_klu2_version();
-        available = sp::amesos2_klu2_available();
-        break;
-      case SP_SOLVER_GMRES_ILU: what = sp::krylov_version(); break;
-      case SP_SOLVER_GMRES_CELLS: what = sp::cell_blocks_version(); break;
-      default: return -1;
-    }
-  } catch (...) {
-    available = 0;
-  }
-  if (backend) *backend = what;
-  return available;
+  return sp::linear_solver_version(linear, backend);
 }
 
 int sp_solver_create(MPI_Comm comm, const sp_solver_options *options, sp_solver *out) {
@@ -78,7 +58,7 @@ int sp_solver_create(MPI_Comm comm, const sp_solver_options *options, sp_solver 
   if (!s) return SP_SOLVER_ERR_MEMORY;
   *out = s;
   return guarded(s, [&] {
-    // The fault hook (src/fault.h): SOFTPACK_FAULT=solver:RANK fails one
+    // The fault hook (src/base/fault.h): SOFTPACK_FAULT=solver:RANK fails one
     // rank as a library would. The ranks agree on it before the solver's
     // collectives begin, so every rank reports the failure.
     int rank = 0, faulty = -1, faulty_rank = -1;

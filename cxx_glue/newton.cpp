@@ -26,7 +26,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "errors.hpp"
+#include "base/errors.hpp"
 
 namespace sp {
 namespace {
@@ -61,18 +61,7 @@ const double *local(const NOX::Abstract::Vector &v) {
 }
 
 // The GMRES solvers' options from the scene's: the tolerance as resolved
-// (src/run_options.c turns the scene's 0 into the solver's default).
-KrylovOptions krylov_options(const sp_solver_options &options) {
-  KrylovOptions k;
-  k.tolerance = options.krylov_tol;
-  if (!(k.tolerance > 0 && k.tolerance < 1)) {
-    char got[32];
-    std::snprintf(got, sizeof got, "%g", k.tolerance);
-    throw input_error(std::string("solver.krylov_tol: expected 0 < tol < 1, got ") + got);
-  }
-  return k;
-}
-
+// (src/run/run_options.c turns the scene's 0 into the solver's default).
 // NOX's model of a step's equations (a Thyra ModelEvaluator): F(x) and
 // the Jacobian at x into the operator NOX passes (JacobianSolve, which
 // stands for Solver's matrix). Built once per layout with the group;
@@ -391,47 +380,7 @@ Solver::Solver(MPI_Comm comm, const sp_solver_options &options)
     throw input_error("solver.line_search: unknown kind");
   if (!(options.newton_divergence == 0 || options.newton_divergence > 1))
     throw input_error("solver.newton_divergence: expected 0 (off) or a value > 1");
-  const int P = n_ranks_;
-  std::unique_ptr<DirectSolver> direct;
-  switch (options.linear) {
-    case SP_SOLVER_SUPERLU:
-      // Serial SuperLU under MPI: the matrix is gathered on rank 0.
-      direct = P == 1 ? make_superlu()
-                       : make_gathered(comm, rank_ == 0 ? make_superlu() : nullptr);
-      break;
-    case SP_SOLVER_SUPERLU_DIST:
-      direct = make_superlu_dist(comm, options.ordering == SP_SOLVER_ORDER_PAIRS,
-                                  options.refine != 0);
-      break;
-    case SP_SOLVER_MUMPS: direct = make_mumps(comm); break;
-    case SP_SOLVER_KLU:  // serial KLU under MPI: gathered on rank 0, as SuperLU
-      direct = P == 1 ? make_klu() : make_gathered(comm, rank_ == 0 ? make_klu() : nullptr);
-      break;
-    case SP_SOLVER_KLU2:
-      // Debian 13.2's Amesos2 KLU2 returns wrong solutions on several
-      // ranks (a gcc 12 miscompile, docs/building.md): one process only.
-      // Every rank refuses here, at set-up, before anything is written.
-      if (P > 1)
-        throw input_error("solver.linear: klu2 runs on one MPI process only (this run has " +
-                          std::to_string(P) +
-                          "): Debian's Amesos2 KLU2 (Trilinos 13.2) is miscompiled by gcc 12 and "
-                          "gives wrong answers on 2 or more processes (docs/building.md); use "
-                          "superlu_dist, mumps or klu with several processes");
-      direct = make_amesos2_klu2(comm);
-      break;
-    case SP_SOLVER_GMRES_ILU: {
-      // taken as given: 0 is ILU(0), not a default (the scene has those)
-      if (options.ilu_fill < 0)
-        throw input_error("solver.ilu_fill: expected a fill level >= 0, got " +
-                          std::to_string(options.ilu_fill));
-      KrylovOptions k = krylov_options(options);
-      k.fill = options.ilu_fill;
-      direct = make_krylov(comm, k);
-      break;
-    }
-    case SP_SOLVER_GMRES_CELLS: direct = make_cell_blocks(comm, krylov_options(options)); break;
-    default: throw input_error("solver.linear: unknown kind");
-  }
+  std::unique_ptr<LinearSolver> direct = make_linear_solver(comm, options);
   linear_ = std::make_unique<LowRankSolver>(comm, std::move(direct));
 
   nox_ = std::make_unique<Nox>();
@@ -767,7 +716,7 @@ bool Solver::factor_jacobian(std::string &why) {
   linear_->set_rhs_count(1);
   bool ok = linear_->factor(A, !pattern_changed_, why);
   int oom = !ok && linear_->out_of_memory();
-  if (ok && sp_fault_due(SP_FAULT_FACTOR, rank_)) {  // (src/fault.h)
+  if (ok && sp_fault_due(SP_FAULT_FACTOR, rank_)) {  // (src/base/fault.h)
     ok = false;
     oom = 1;
     why = "out of memory in the factorisation on rank " + std::to_string(rank_) +

@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "assembly.hpp"
-#include "linear.hpp"
-#include "linear_low_rank.hpp"
-#include "shape_implicit.hpp"
+#include "assembly/assembly.hpp"
+#include "linear/linear.hpp"
+#include "linear/linear_low_rank.hpp"
+#include "assembly/shape_implicit.hpp"
 #include "softpack_solver.h"
 
 namespace sp {

@@ -4,7 +4,8 @@
  *   run_scene SCENE.yaml OUT_DIR [MAX_CELLS] [section.key=value]...
  *
  * prints one line per accepted step (step, t, dt, cells, the total cell
- * mass) and stops the run once MAX_CELLS cells exist (default: never).
+ * mass and the cells' mass-weighted centre, x y in 2D, x y z in 3D) and
+ * stops the run once MAX_CELLS cells exist (default: never).
  * Exit status: 0, or the run's error code's exit status (2: bad input). */
 #include <mpi.h>
 #include <stdio.h>
@@ -18,13 +19,19 @@ typedef struct {
 
 static int watch(const sp_step_info *s, void *user) {
   const limits *lim = user;
-  double mass = 0;
-  for (int k = 0; k < s->n_cells; ++k) mass += s->cells[k].mass;
+  double mass = 0, centre[SP_DIM_MAX] = {0};
+  for (int k = 0; k < s->n_cells; ++k) {
+    mass += s->cells[k].mass;
+    for (int d = 0; d < s->dim; ++d) centre[d] += s->cells[k].mass * s->cells[k].centre[d];
+  }
   int rank;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  if (rank == 0)
-    printf("step %d t %.6g dt %.3g cells %d mass %.10g\n", s->step, s->t, s->dt, s->n_cells,
-           mass);
+  if (rank == 0) {
+    printf("step %d t %.6g dt %.3g cells %d mass %.10g centre", s->step, s->t, s->dt,
+           s->n_cells, mass);
+    for (int d = 0; d < s->dim; ++d) printf(" %.10g", centre[d] / mass);
+    printf("\n");
+  }
   return lim->max_cells > 0 && s->n_cells >= lim->max_cells;
 }
 

@@ -6,12 +6,12 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "division.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
+#include "model/division.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
 
 /** Mass of cell k = sum_i w_i c_k(i) (w_i the node weights), summed in
  *  long double: the same integral as sp_cells_observe's, but with a

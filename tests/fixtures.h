@@ -7,15 +7,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
-#include "q1.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 #include "softpack_solver.h"
-#include "resize.h"
-#include "stepper.h"
+#include "run/resize.h"
+#include "run/stepper.h"
 
 /** A division's set-up: a 160 x 160 mesh of the unit square, full layouts
  *  of 1 cell (the parent) and 2 (the daughters), their states zeroed;
@@ -84,7 +84,7 @@ static inline sp_solver make_solver_with(const sp_mesh *mesh, const sp_layout *l
 }
 
 static inline sp_solver make_solver(const sp_mesh *mesh, const sp_layout *layout, int jacobian) {
-  return make_solver_with(mesh, layout, jacobian, SP_SOLVER_SUPERLU);
+  return make_solver_with(mesh, layout, jacobian, SP_LINEAR_SUPERLU);
 }
 
 /** The largest relative difference of Jacobian kinds @p a and @p b at

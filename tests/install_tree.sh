@@ -101,6 +101,14 @@ echo "$ran"
   grep -Eq '^step 2 t [0-9.e+-]+ dt [0-9.e+-]+ cells 3 mass [0-9]' <<< "$ran" &&
   grep -q "^2 steps, stopped early: no$" <<< "$ran" || fail "run_scene printed otherwise"
 [ -s "$tmp/run_scene_out/energy.csv" ] || fail "run_scene wrote no energy.csv"
+# the callback's centres (sp_cell_obs.centre) are cells.csv's: the
+# mass-weighted centre of step 2's rows to 1e-9
+want=$(awk -F, 'NR > 1 && $1 == 2 { m += $4; x += $4 * $5; y += $4 * $6 }
+                END { printf "%.10g %.10g", x / m, y / m }' "$tmp/run_scene_out/cells.csv")
+got=$(sed -n 's/^step 2 .* centre \([^ ]*\) \([^ ]*\)$/\1 \2/p' <<< "$ran")
+awk -v w="$want" -v g="$got" 'BEGIN { split(w, a, " "); split(g, b, " ");
+  exit !(b[1] != "" && (a[1] - b[1])^2 + (a[2] - b[2])^2 < 1e-18) }' ||
+  fail "run_scene's centre ($got) is not cells.csv's ($want)"
 # a bad override: exit status 2, the key named, nothing run
 status=0
 (cd "$tmp" && "$tmp/examples/run_scene" "$scene" "$tmp/bad_out" 0 time.dt=-1) \

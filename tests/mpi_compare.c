@@ -18,7 +18,7 @@
  *     max |x_k - x_k,ref| <= 1e-10 max |x_k,ref| for k = 1..4.
  *
  *   mpi_compare library SCENE [section.key=value]...
- *     The library under faults (src/fault.h): with SOFTPACK_FAULT set on
+ *     The library under faults (src/base/fault.h): with SOFTPACK_FAULT set on
  *     every rank to a fault on one rank (at set-up, in the solver's
  *     creation, in a step, at output, inside the glue's residual fill
  *     and where it takes a layout, each before its collective; rank 1,
@@ -53,9 +53,9 @@
 #include <time.h>
 
 #include "fixtures.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "output_read.h"
-#include "run.h"
+#include "public/run.h"
 
 static double rel(double a, double b) {
   double s = fmax(fabs(a), fabs(b));
@@ -282,11 +282,11 @@ static int cmd_steps(int argc, char **argv, int rank, int size) {
 /* ---------- iterates: one step's Newton iterates per backend ---------- */
 
 static int linear_kind(const char *name) {
-  if (strcmp(name, "superlu") == 0) return SP_SOLVER_SUPERLU;
-  if (strcmp(name, "superlu_dist") == 0) return SP_SOLVER_SUPERLU_DIST;
-  if (strcmp(name, "mumps") == 0) return SP_SOLVER_MUMPS;
-  if (strcmp(name, "klu2") == 0) return SP_SOLVER_KLU2;
-  if (strcmp(name, "klu") == 0) return SP_SOLVER_KLU;
+  if (strcmp(name, "superlu") == 0) return SP_LINEAR_SUPERLU;
+  if (strcmp(name, "superlu_dist") == 0) return SP_LINEAR_SUPERLU_DIST;
+  if (strcmp(name, "mumps") == 0) return SP_LINEAR_MUMPS;
+  if (strcmp(name, "klu2") == 0) return SP_LINEAR_KLU2;
+  if (strcmp(name, "klu") == 0) return SP_LINEAR_KLU;
   return -1;
 }
 
@@ -335,7 +335,7 @@ static int cmd_iterates(int argc, char **argv, int rank, int size) {
   double *got = malloc((size_t)N_ITERATES * n * sizeof(double));
   double t_ref;
   /* Every rank computes the serial reference alone (the same numbers). */
-  newton_iterates(MPI_COMM_SELF, SP_SOLVER_SUPERLU, mesh, layout, old, guess, ref, &t_ref);
+  newton_iterates(MPI_COMM_SELF, SP_LINEAR_SUPERLU, mesh, layout, old, guess, ref, &t_ref);
   if (rank == 0) printf("%d unknowns; serial superlu: 4 iterates in %.2f s\n", n, t_ref);
   for (int a = 0; a < argc; ++a) {
     const int kind = linear_kind(argv[a]);

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# MUMPS short of memory (cxx_glue/linear_mumps.cpp, docs/robustness.md),
+# MUMPS short of memory (cxx_glue/linear/linear_mumps.cpp, docs/robustness.md),
 # with a malloc that refuses large blocks (tests/malloc_cap.c, LD_PRELOAD),
 # on a small 3D scene with MUMPS:
 # 1. the run as it is, reporting its largest allocation M: MUMPS's

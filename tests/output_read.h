@@ -1,4 +1,4 @@
-/* Reading what src/output.c writes, for tests: whole files, the CSV logs
+/* Reading what src/io/output.c writes, for tests: whole files, the CSV logs
  * (energy.csv, cells.csv, divisions.csv) by column name, and the
  * DataArrays of a .vtu (inline base64 with a UInt64 byte-count header). */
 #ifndef SP_TEST_OUTPUT_READ_H

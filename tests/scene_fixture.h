@@ -9,8 +9,8 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "error.h"
-#include "run_setup.h"
+#include "public/error.h"
+#include "run/run_setup.h"
 
 /** A set-up run and its summary (the run points into it: not movable). */
 typedef struct {

@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "fixtures.h"
-#include "shape.h"
+#include "model/shape.h"
 
 /** The observables (threshold 0) with the nodal c of pair @p p moved by
  *  +step and -step; the state is restored. */
@@ -79,7 +79,7 @@ typedef struct {
   double threshold;    /**< the moments count c >= this (and the term acts there) */
   double background;   /**< c += background (1 - c) */
   int implicit;        /**< sp_step_data.shape_implicit */
-  int linear;          /**< SP_SOLVER_SUPERLU, ... */
+  int linear;          /**< SP_LINEAR_SUPERLU, ... */
   int steps;
   double dt;
 } relax_setup;
@@ -137,8 +137,8 @@ static inline relax_result relax_ellipse(relax_setup r) {
   sp_cell_obs obs;
   CHECK_OK(sp_cells_observe(mesh, layout, state, r.threshold, &obs));
   const sp_cell_birth birth = {.birth_mass = obs.mass_core,
-                               .Iref = {obs.I1, r.iref2_factor * obs.I2}};
-  out.i2_start = obs.I2;
+                               .Iref = {obs.moments[0], r.iref2_factor * obs.moments[1]}};
+  out.i2_start = obs.moments[1];
   out.i2_ref = birth.Iref[1];
   sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, r.linear);
   double energy = energy_total(solver, &model, state) +
@@ -168,7 +168,7 @@ static inline relax_result relax_ellipse(relax_setup r) {
     ++out.steps_done;
   }
   out.energy_end = energy;
-  out.i2_end = obs.I2;
+  out.i2_end = obs.moments[1];
   sp_solver_destroy(&solver);
   one_cell_destroy(&o);
   return out;

@@ -11,10 +11,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "scene.h"
-#include "stepper.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 #define T_DIV 0.002
 #define T_END 0.0045

@@ -27,9 +27,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "run.h"
+#include "public/run.h"
 
 #define SCENE SP_SOURCE_DIR "/inputs/embryo/celegans_8_2d.yaml"
 #define OUT "test_celegans_2d_out"

@@ -9,7 +9,7 @@
  * filter to drop a cell's own entries it could not). At a loose
  * tolerance (1e-4), with Newton ending on a solve's update, each cell's
  * mass is still conserved to 1e-12 per step (the c rows of A and of the
- * preconditioner are the same: linear_cells.cpp says why that keeps the
+ * preconditioner are the same: linear_gmres_cells.cpp says why that keeps the
  * masses). A tolerance GMRES
  * cannot reach fails the step and leaves the state; a bad tolerance is
  * refused naming solver.krylov_tol. */
@@ -24,10 +24,10 @@ enum { N_STEPS = 3 };
 static void compare_with_superlu(const sp_mesh *mesh, const sp_layout *layout,
                                  const double *start, const char *what, long *gmres_its,
                                  long *newton_its) {
-  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_GMRES_CELLS);
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_LINEAR_GMRES_CELLS);
   opt.krylov_tol = 1e-10; /* the scene's default */
   sp_solver solvers[2] = {make_solver_opts(mesh, layout, &opt),
-                          make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU)};
+                          make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_LINEAR_SUPERLU)};
   const int n = 2 * layout->n_pairs;
   double *x[2], *old = malloc(sizeof(double) * n);
   for (int s = 0; s < 2; ++s) {
@@ -83,7 +83,7 @@ int main(int argc, char **argv) {
 
   /* a loose tolerance: the masses stay to round-off */
   {
-    sp_solver_options loose = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_GMRES_CELLS);
+    sp_solver_options loose = test_options(SP_SOLVER_JAC_AD, SP_LINEAR_GMRES_CELLS);
     loose.krylov_tol = 1e-4;
     loose.newton_rtol = 1e-3; /* Newton ends on a solve's update: its */
     loose.newton_atol = 1e-9; /* residual is the GMRES's */
@@ -116,7 +116,7 @@ int main(int argc, char **argv) {
   }
 
   /* an unreachable tolerance: the step fails, the state stays */
-  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_GMRES_CELLS);
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_LINEAR_GMRES_CELLS);
   opt.krylov_tol = 1e-30;
   sp_solver strict = make_solver_opts(mesh, layout, &opt);
   double *y = malloc(sizeof(double) * n), *old = malloc(sizeof(double) * n);

@@ -1,4 +1,4 @@
-/* Checkpoints alone (src/checkpoint.c), no time stepping:
+/* Checkpoints alone (src/run/checkpoint.c), no time stepping:
  * - a round trip of the run state: a run set up from a scene as a run is
  *   (scene_fixture.h), moved to random supports with every member set (two
  *   past states, a registry with names and cut normals, the controller,
@@ -17,9 +17,9 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "checkpoint.h"
-#include "error.h"
-#include "resize.h"
+#include "run/checkpoint.h"
+#include "public/error.h"
+#include "run/resize.h"
 #include "scene_fixture.h"
 
 #define DIR "checkpoint_test"

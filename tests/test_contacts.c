@@ -1,4 +1,4 @@
-/* Contacts measured from the fields (src/contacts.h; docs/model.md,
+/* Contacts measured from the fields (src/model/contacts.h; docs/model.md,
  * "Contacts"), on the exact equilibrium profile c = 1 / (1 + e^(s/d))
  * interpolated on Q1 meshes of decreasing h (2D quadrilaterals, 3D
  * hexahedra; d fixed):
@@ -37,12 +37,13 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "contacts.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
+#include "model/contacts.h"
+#include "io/contacts_out.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
 #include "output_read.h"
 
 /** A cell's signed distance function (> 0 outside) at x[0..dim). */
@@ -245,7 +246,7 @@ static void test_lone_and_apart(void) {
       CHECK(at(&t, i, "other") == 0 && at(&t, i, "cell") == i + 1, "row %d not a cell row", i);
       CHECK(at(&t, i, "contact") == 0, "row %d: contact %g", i, at(&t, i, "contact"));
       CHECK(at(&t, i, "free_surface") == at(&t, i, "surface"), "row %d: free != total", i);
-      CHECK(at(&t, i, "volume") == obs[i].area, "row %d: volume is not cells.csv's area", i);
+      CHECK(at(&t, i, "volume") == obs[i].volume, "row %d: volume is not cells.csv's area", i);
     }
     free(t.v);
     free(state);

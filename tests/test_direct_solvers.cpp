@@ -1,4 +1,4 @@
-// The direct solvers behind cxx_glue/linear.hpp on matrices whose answer is
+// The direct solvers behind cxx_glue/linear/linear.hpp on matrices whose answer is
 // known, on however many ranks it runs (ctest: one and two):
 // - a nonsymmetric, diagonally dominant 2-D convection-diffusion matrix
 //   (n = 40 x 40) with a known solution: every backend reproduces it to
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "linear.hpp"
+#include "linear/linear.hpp"
 
 namespace {
 
@@ -98,7 +98,7 @@ int main(int argc, char **argv) {
 
   struct Backend {
     const char *name;
-    std::unique_ptr<sp::DirectSolver> solver;
+    std::unique_ptr<sp::LinearSolver> solver;
   };
   std::vector<Backend> backends;
   backends.push_back({"mumps", sp::make_mumps(MPI_COMM_WORLD)});

@@ -7,10 +7,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "scene.h"
-#include "stepper.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);

@@ -1,4 +1,4 @@
-/* Cell division building blocks (src/division.c): the axis of elliptical
+/* Cell division building blocks (src/model/division.c): the axis of elliptical
  * cells at several orientations, the split's exact mass conservation and
  * equal halves (sharp and smoothed), the crossing-safe criteria, the paper's
  * dt sequence after a division (algorithm 2) and N_max. */
@@ -6,15 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "division.h"
+#include "model/division.h"
 #include "division_fixtures.h"
-#include "error.h"
+#include "public/error.h"
 #include "fixtures.h"
-#include "layout.h"
-#include "mesh.h"
-#include "q1.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 
 #define PI 3.14159265358979323846
 
@@ -69,8 +69,10 @@ static void test_axis_of_ellipses(void) {
     set_ellipse_bg(mesh, layout, state, 0, xc, yc, 0.12, 0.06, phi, 0.0);
     sp_cell_obs obs;
     CHECK_OK(sp_cells_observe(mesh, layout, state, WEIGHT_THRESHOLD, &obs));
-    double px, py, dx, dy;
-    sp_division_axis(&obs, &px, &py, &dx, &dy);
+    double point[3], normal[3];
+    sp_division_plane(&obs, 2, point, normal);
+    /* the cut's line: the normal turned by -90 degrees */
+    const double px = point[0], py = point[1], dx = normal[1], dy = -normal[0];
     /* expected: perpendicular to the long axis (cos phi, sin phi) */
     const double ex = -sin(phi), ey = cos(phi);
     const double error = line_angle(dx, dy, ex, ey);
@@ -78,14 +80,14 @@ static void test_axis_of_ellipses(void) {
     double expected = atan2(ey, ex);
     if (expected > PI / 2) expected -= PI;
     printf("  %15.4f | %16.6f | %14.6f | %11.2e | %12.2e | %.4f\n", phi,
-           atan2(dy, dx), expected, error, centre_error, obs.I1 / obs.I2);
+           atan2(dy, dx), expected, error, centre_error, obs.moments[0] / obs.moments[1]);
     if (error > worst) worst = error;
     CHECK(error < 1e-3, "orientation %g: axis off by %.3g rad", phi, error);
     /* the c >= 0.05 cut of the weight is not resolved by the quadrature */
     CHECK(centre_error < 5e-5, "orientation %g: centre off by %.3g", phi, centre_error);
     CHECK_NEAR(hypot(dx, dy), 1.0, 1e-14);
-    CHECK(obs.I1 > 2.0 * obs.I2, "orientation %g: I1/I2 = %g, an ellipse 2:1 has ~4",
-          phi, obs.I1 / obs.I2);
+    CHECK(obs.moments[0] > 2.0 * obs.moments[1], "orientation %g: I1/I2 = %g, an ellipse 2:1 has ~4",
+          phi, obs.moments[0] / obs.moments[1]);
   }
   printf("  largest axis error: %.3g rad\n", worst);
   free(state);
@@ -111,7 +113,8 @@ static double *nodal_weights(const sp_mesh *mesh) {
 /** Signed distance of node i from the axis of obs, with n = v2 (the side
  *  the child takes is sd > 0). */
 static double signed_distance(const sp_mesh *mesh, const sp_cell_obs *obs, int i) {
-  return -obs->v1[1] * (mesh->xy[2 * i] - obs->xc) + obs->v1[0] * (mesh->xy[2 * i + 1] - obs->yc);
+  const double *n = obs->axes[obs->long_axis]; /* the cut's normal */
+  return n[0] * (mesh->xy[2 * i] - obs->centre[0]) + n[1] * (mesh->xy[2 * i + 1] - obs->centre[1]);
 }
 
 /** Split cell 0 (an ellipse at (x, y), long axis at phi, on a background)
@@ -173,9 +176,10 @@ static double check_split(const sp_mesh *mesh, const double *w, double x, double
         wrong_side);
   CHECK(bystander_changed == 0, "%s: %d bystander values changed", label, bystander_changed);
 
-  /* the child's centre lies on the side of n = v2 */
-  const double side = -before[0].v1[1] * (after[2].xc - before[0].xc) +
-                      before[0].v1[0] * (after[2].yc - before[0].yc);
+  /* the child's centre lies on the side the normal n (the long axis) points to */
+  const double *n = before[0].axes[before[0].long_axis];
+  const double side = n[0] * (after[2].centre[0] - before[0].centre[0]) +
+                      n[1] * (after[2].centre[1] - before[0].centre[1]);
   CHECK(side > 0, "%s: child centre on the wrong side (n . (Xc_child - Xc) = %g)", label, side);
   const double unequal = fabs(m_parent - m_child) / (0.5 * (m_parent + m_child));
   printf("  %-40s | %9.1e | %9.1e | %.6f %.6f | %.2e\n", label, conservation, observed,
@@ -369,9 +373,9 @@ static void test_mass_criterion(void) {
 
 /* The birth records after a split: time, masses, moments, generation. */
 static void test_birth_records(void) {
-  sp_cell_obs obs[3] = {{.mass = 1.0, .I1 = 3.0, .I2 = 1.0},
-                        {.mass = 0.52, .I1 = 0.9, .I2 = 0.4},
-                        {.mass = 0.48, .I1 = 0.8, .I2 = 0.5}};
+  sp_cell_obs obs[3] = {{.mass = 1.0, .moments = {3.0, 1.0}},
+                        {.mass = 0.52, .moments = {0.9, 0.4}},
+                        {.mass = 0.48, .moments = {0.8, 0.5}}};
   sp_cell_birth registry[3];
   registry[0] = sp_cell_birth_make(0.0, &obs[0], 0);
   registry[1] = sp_cell_birth_make(0.0, &obs[0], 0);
@@ -483,31 +487,37 @@ static void test_equal_mass_line(void) {
   split_teardown(&mesh, &layout, &new_layout, &state, &new_state);
 }
 
-/* Which daughter takes the new label follows v1's sign. For a cut along
- * the vertical (symmetric scenes make them) a round-off-sized Ixy of
- * either sign must give the same v1; everywhere v1 is the unit
- * eigenvector of the larger eigenvalue, at an angle in
- * (0.2 - pi/2, 0.2 + pi/2]. */
+/* Which daughter takes the new label follows the sign of the cut's normal,
+ * the long axis (axes[1] in 2D). For a cut along the vertical (symmetric
+ * scenes make them) a round-off-sized Ixy of either sign must give the
+ * same normal; everywhere the normal is the unit eigenvector of the
+ * smaller moment, at an angle in [0.2, 0.2 + pi] from the x axis, and
+ * axes[0] the larger moment's. */
 static void test_axis_sign_convention(void) {
-  double I1, I2, v1[2], v2[2], w1[2], w2[2];
-  sp_cells_principal(1.0, 2.0, 1e-17, &I1, &I2, v1, v2);
-  sp_cells_principal(1.0, 2.0, -1e-17, &I1, &I2, w1, w2);
-  printf("vertical axis, Ixy = +-1e-17: v1 = (%.3g, %.3g) and (%.3g, %.3g)\n", v1[0], v1[1],
-         w1[0], w1[1]);
-  CHECK(fabs(v1[0] - w1[0]) < 1e-15 && fabs(v1[1] - w1[1]) < 1e-15 && v1[1] > 0.99,
-        "vertical axis: v1 (%g, %g) against (%g, %g)", v1[0], v1[1], w1[0], w1[1]);
+  double I[3], v[3][3], w[3][3];
+  sp_cells_principal(2, (const double[3][3]){{1.0, 1e-17, 0}, {1e-17, 2.0, 0}, {0, 0, 0}}, I, v);
+  sp_cells_principal(2, (const double[3][3]){{1.0, -1e-17, 0}, {-1e-17, 2.0, 0}, {0, 0, 0}}, I, w);
+  printf("vertical cut, Ixy = +-1e-17: normal = (%.3g, %.3g) and (%.3g, %.3g)\n", v[1][0],
+         v[1][1], w[1][0], w[1][1]);
+  CHECK(fabs(v[1][0] - w[1][0]) < 1e-15 && fabs(v[1][1] - w[1][1]) < 1e-15 && v[1][0] < -0.99,
+        "vertical cut: normal (%g, %g) against (%g, %g)", v[1][0], v[1][1], w[1][0], w[1][1]);
   double worst = 0;
   for (int j = 0; j < 360; ++j) {
     const double phi = M_PI * (j + 0.5) / 180.0 - M_PI; /* the long axis, all ways */
     const double a = 2.0, b = 1.0, c = cos(phi), s = sin(phi);
     const double Ixx = a * c * c + b * s * s, Iyy = a * s * s + b * c * c, Ixy = (a - b) * c * s;
-    sp_cells_principal(Ixx, Iyy, Ixy, &I1, &I2, v1, v2);
-    const double angle = atan2(v1[1], v1[0]);
-    const double r0 = Ixx * v1[0] + Ixy * v1[1] - I1 * v1[0];
-    const double r1 = Ixy * v1[0] + Iyy * v1[1] - I1 * v1[1];
-    worst = fmax(worst, hypot(r0, r1));
-    CHECK(angle > 0.2 - M_PI / 2 && angle <= 0.2 + M_PI / 2 + 1e-12,
-          "long axis %g: v1 at %g rad", phi, angle);
+    sp_cells_principal(2, (const double[3][3]){{Ixx, Ixy, 0}, {Ixy, Iyy, 0}, {0, 0, 0}}, I, v);
+    for (int i = 0; i < 2; ++i) {
+      const double r0 = Ixx * v[i][0] + Ixy * v[i][1] - I[i] * v[i][0];
+      const double r1 = Ixy * v[i][0] + Iyy * v[i][1] - I[i] * v[i][1];
+      worst = fmax(worst, hypot(r0, r1));
+    }
+    double angle = atan2(v[1][1], v[1][0]);
+    if (angle < 0.2 - 1e-12) angle += 2 * M_PI;
+    CHECK(I[0] >= I[1] && I[2] == 0 && v[2][0] == 0 && v[2][1] == 0 && v[2][2] == 0,
+          "long axis %g: moments %g, %g, %g", phi, I[0], I[1], I[2]);
+    CHECK(angle >= 0.2 - 1e-12 && angle <= 0.2 + M_PI + 1e-12, "long axis %g: normal at %g rad",
+          phi, angle);
   }
   CHECK(worst < 1e-14, "eigenvector residual %.3g", worst);
 }

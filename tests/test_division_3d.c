@@ -1,4 +1,4 @@
-/* Division on a 3D mesh (src/division.c, issue 29 phase 2; docs/3d.md):
+/* Division on a 3D mesh (src/model/division.c, issue 29 phase 2; docs/3d.md):
  * the cut is the plane through the centre of mass normal to the long axis
  * (the eigenvector of the smallest principal moment, sp_division_plane).
  *  - an ellipsoid 0.14 x 0.08 x 0.07 long along x, and the same turned to a
@@ -26,14 +26,14 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "division.h"
+#include "model/division.h"
 #include "division_fixtures.h"
-#include "error.h"
+#include "public/error.h"
 #include "fixtures.h"
-#include "layout.h"
-#include "mesh.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
 
 /** Centre and inertia integrate c >= this, as the stepper does. */
 #define WEIGHT_THRESHOLD 0.05
@@ -107,10 +107,10 @@ static void check_split(const sp_mesh *mesh, const double axes[3][3], int smooth
   CHECK(worst_sum <= 1e-15, "%s: |c_parent + c_child - c| up to %.3g", label, worst_sum);
 
   /* the daughters' centres: apart along the long axis, the child on n's side */
-  const double apart[3] = {after[2].xc - after[0].xc, after[2].yc - after[0].yc,
-                           after[2].zc - after[0].zc};
-  const double child_side[3] = {after[2].xc - point[0], after[2].yc - point[1],
-                                after[2].zc - point[2]};
+  const double apart[3] = {after[2].centre[0] - after[0].centre[0], after[2].centre[1] - after[0].centre[1],
+                           after[2].centre[2] - after[0].centre[2]};
+  const double child_side[3] = {after[2].centre[0] - point[0], after[2].centre[1] - point[1],
+                                after[2].centre[2] - point[2]};
   const double apart_angle = line_angle3(apart, axes[0]), distance = norm3(apart);
   const double expected = halves_apart(semi[0], width / semi[2]);
   const double unequal = fabs(m_parent - m_child) / (0.5 * (m_parent + m_child));

@@ -13,10 +13,10 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "scene.h"
-#include "stepper.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 static int count_rows(const char *path, int *same_step) {
   FILE *f = fopen(path, "r");

@@ -1,13 +1,13 @@
-/* The time-step controller alone (src/dt_control.h), no solver: accept and
+/* The time-step controller alone (src/time/dt_control.h), no solver: accept and
  * reject, growth and cut bounds, Newton failures, restart after a division,
  * landing on events and on t_end without a sliver, and the fixed policy's
  * rules (the paper's runs). */
 #include <math.h>
 
 #include "check.h"
-#include "division.h"
-#include "dt_control.h"
-#include "error.h"
+#include "model/division.h"
+#include "time/dt_control.h"
+#include "public/error.h"
 
 static sp_dt_params adaptive_params(int order) {
   sp_dt_params p = {.policy = SP_DT_ADAPTIVE, .dt = 1e-3, .dt_min = 1e-12, .dt_max = 0.5,

@@ -5,9 +5,9 @@
 
 #include "check.h"
 #include "output_read.h"
-#include "error.h"
-#include "scene.h"
-#include "stepper.h"
+#include "public/error.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);

@@ -1,5 +1,5 @@
 /* The classes of errors at the C/C++ boundary (c_api/softpack_solver.h,
- * src/solver_status.h) and their exit statuses: only bad input exits 2.
+ * src/run/solver_status.h) and their exit statuses: only bad input exits 2.
  * - the glue refuses options as bad input, and null arguments as internal;
  * - every glue status maps to its core code, an unknown one to internal;
  * - a solver creation that fails (the fault hook SOFTPACK_FAULT=solver:0)
@@ -18,11 +18,11 @@
 
 #include "check.h"
 #include "command.h"
-#include "layout.h"
-#include "run.h"
-#include "solver_status.h"
-#include "resize.h"
-#include "stepper.h"
+#include "mesh/layout.h"
+#include "public/run.h"
+#include "run/solver_status.h"
+#include "run/resize.h"
+#include "run/stepper.h"
 
 static const char scene[] =
     "mesh: {type: rectangle, x0: 0, y0: 0, x1: 1, y1: 1, nx: 12, ny: 12}\n"
@@ -61,7 +61,7 @@ int main(int argc, char **argv) {
   struct stat st;
 
   /* options the glue refuses: bad input; a null argument: a bug */
-  sp_solver_options opt = {.jacobian = 99, .linear = SP_SOLVER_SUPERLU, .newton_rtol = 1e-8,
+  sp_solver_options opt = {.jacobian = 99, .linear = SP_LINEAR_SUPERLU, .newton_rtol = 1e-8,
                            .newton_atol = 1e-10, .newton_max_its = 10};
   sp_solver s = NULL;
   int status = sp_solver_create(MPI_COMM_WORLD, &opt, &s);

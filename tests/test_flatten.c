@@ -19,9 +19,9 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "error.h"
-#include "mesh.h"
-#include "q1.h"
+#include "public/error.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 
 static int make(int dim, int r, const double semi[3], int layers, double w, sp_mesh **mesh) {
   return dim == 3 ? sp_mesh_ellipsoid(r, semi[0], semi[1], semi[2], layers, w, mesh)

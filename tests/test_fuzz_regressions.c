@@ -8,8 +8,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "scene.h"
+#include "public/error.h"
+#include "scene/scene.h"
 
 int main(void) {
   const char *dir_path = SP_SOURCE_DIR "/tests/scenes/fuzz";

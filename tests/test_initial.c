@@ -1,4 +1,4 @@
-/* Initial fields from files (src/initial.c):
+/* Initial fields from files (src/io/initial.c):
  * - a label image (three disks of three colours drawn with cairo, no
  *   antialiasing): three cells, numbered by colour; each cell's mass is its
  *   label's pixel area plus the equilibrium profile's own excess
@@ -14,14 +14,14 @@
 #include <cairo.h>
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "error.h"
-#include "initial.h"
+#include "public/error.h"
+#include "io/initial.h"
 #include "output_read.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "scene_fixture.h"
-#include "stepper.h"
+#include "run/stepper.h"
 
 #define W 200
 #define H 100
@@ -109,10 +109,10 @@ static void label_image(void) {
     const double want = area[k] + excess;
     printf("cell %d: mass %.6f, pixels %.6f + profile %.6f = %.6f (%.2e); centre (%.5f, %.5f), "
            "pixels (%.5f, %.5f)\n", k + 1, obs[k].mass, area[k], excess, want,
-           obs[k].mass / want - 1, obs[k].xc, obs[k].yc, sx[k] / area[k], sy[k] / area[k]);
+           obs[k].mass / want - 1, obs[k].centre[0], obs[k].centre[1], sx[k] / area[k], sy[k] / area[k]);
     CHECK(fabs(obs[k].mass / want - 1) < 0.01, "cell %d: mass %.6f, expected %.6f", k + 1,
           obs[k].mass, want);
-    CHECK(hypot(obs[k].xc - sx[k] / area[k], obs[k].yc - sy[k] / area[k]) < 0.5 * px,
+    CHECK(hypot(obs[k].centre[0] - sx[k] / area[k], obs[k].centre[1] - sy[k] / area[k]) < 0.5 * px,
           "cell %d: centre off the image's by more than half a pixel", k + 1);
   }
   /* a missing image: bad input naming the key, when the scene is read */
@@ -170,7 +170,7 @@ static void vtu_start(void) {
     ++matched;
     CHECK(fabs(obs[k].mass / at(&cells, i, "mass") - 1) < 1e-12, "cell %d: mass %.17g, cells.csv "
           "%.17g", k + 1, obs[k].mass, at(&cells, i, "mass"));
-    CHECK(hypot(obs[k].xc - at(&cells, i, "xc"), obs[k].yc - at(&cells, i, "yc")) < 1e-12,
+    CHECK(hypot(obs[k].centre[0] - at(&cells, i, "xc"), obs[k].centre[1] - at(&cells, i, "yc")) < 1e-12,
           "cell %d: centre", k + 1);
   }
   CHECK(matched == n && n >= 2, "%d cells in the file, %d in cells.csv at step %d", n, matched,

@@ -18,8 +18,8 @@
 
 #include "check.h"
 #include "command.h"
-#include "error.h"
-#include "output.h"
+#include "public/error.h"
+#include "io/output.h"
 #include "output_read.h"
 
 static const char *const box =

@@ -3,7 +3,7 @@
  *  - on random states with 1, 2 and 3 cells (SFad 16 and 32 unknowns, and
  *    DFad at 48), on a box of hexahedra whose nodes are moved at random
  *    (no two faces parallel) with a buffer layer, with a source and the
- *    shape term on the three moments present (src/shape.h; its implicit
+ *    shape term on the three moments present (src/model/shape.h; its implicit
  *    variant's Jacobian: tests/test_shape_3d.c):
  *    hand = AD to 1e-12, AD = central differences to 1e-6, hand = FD to
  *    1e-6, DFad = AD to 1e-12;
@@ -89,7 +89,7 @@ static void newton_step(void) {
   model.kappa = 4e-3;
   int its[2];
   for (int j = 0; j < 2; ++j) {
-    sp_solver s = make_solver_with(mesh, layout, kinds[j], SP_SOLVER_MUMPS);
+    sp_solver s = make_solver_with(mesh, layout, kinds[j], SP_LINEAR_MUMPS);
     result[j] = malloc(n * sizeof(double));
     memcpy(result[j], start, n * sizeof(double));
     sp_step_data data = {.dt = 2e-4, .model = model, .state_old = start};

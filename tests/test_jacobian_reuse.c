@@ -32,7 +32,7 @@ int main(int argc, char **argv) {
   sp_layout *layout;
   three_cell_problem(&mesh, &layout);
   const double theta = 0.25;
-  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU);
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_LINEAR_SUPERLU);
   sp_solver newton = make_solver_opts(mesh, layout, &opt);
   opt.jacobian_reuse = theta;
   sp_solver modified = make_solver_opts(mesh, layout, &opt);

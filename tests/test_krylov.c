@@ -22,13 +22,13 @@ int main(int argc, char **argv) {
   sp_mesh *mesh;
   sp_layout *layout;
   three_cell_problem(&mesh, &layout);
-  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_GMRES_ILU);
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_LINEAR_GMRES_ILU);
   opt.ilu_fill = 2;
   opt.krylov_tol = 1e-10; /* the scene's default */
   sp_solver ilu2 = make_solver_opts(mesh, layout, &opt);
   opt.ilu_fill = 4;
   sp_solver ilu4 = make_solver_opts(mesh, layout, &opt);
-  sp_solver serial = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU);
+  sp_solver serial = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_LINEAR_SUPERLU);
   sp_solver solvers[3] = {ilu2, ilu4, serial};
   const char *names[3] = {"ILU(2)", "ILU(4)", "SuperLU"};
   const int n = 2 * layout->n_pairs;

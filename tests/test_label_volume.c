@@ -1,4 +1,4 @@
-/* Initial fields from a 3D label volume (initial.label_volume, src/initial.c),
+/* Initial fields from a 3D label volume (initial.label_volume, src/io/initial.c),
  * on NIfTI files this test writes with libnifti2:
  * - three ellipsoidal labels (values 3, 7, 12) in a volume whose sform turns
  *   the voxel axes by 90 degrees about z and moves them, placed with
@@ -32,15 +32,15 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
 #include "command.h"
-#include "error.h"
-#include "initial.h"
-#include "layout.h"
-#include "mesh.h"
-#include "run_options.h"
-#include "scene.h"
+#include "public/error.h"
+#include "io/initial.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "run/run_options.h"
+#include "scene/scene.h"
 
 #define N 120              /* voxels a side */
 #define VOXEL 0.5          /* the file's unit (say um) */
@@ -242,15 +242,15 @@ static void ellipsoids_sform(void) {
     const double excess = 2 * M_PI * M_PI * M_PI * d * d / 3 * mean_width(ellipsoids[e].s);
     const double want = st.volume[c] + excess, layer = st.faces[c] * hv / 2;
     const double tol = layer + 0.02 * excess;
-    const double off = sqrt(pow(obs[c].xc - st.centre[c][0], 2) +
-                            pow(obs[c].yc - st.centre[c][1], 2) +
-                            pow(obs[c].zc - st.centre[c][2], 2));
+    const double off = sqrt(pow(obs[c].centre[0] - st.centre[c][0], 2) +
+                            pow(obs[c].centre[1] - st.centre[c][1], 2) +
+                            pow(obs[c].centre[2] - st.centre[c][2], 2));
     printf("  %d (label %d): %.6f (%.6f, %.2f), %.6f (%.6f + %.6f, %.2f), %.2e (%.2f)\n", c + 1,
-           ellipsoids[e].value, obs[c].area, st.volume[c],
-           fabs(obs[c].area - st.volume[c]) / layer, obs[c].mass, st.volume[c], excess,
+           ellipsoids[e].value, obs[c].volume, st.volume[c],
+           fabs(obs[c].volume - st.volume[c]) / layer, obs[c].mass, st.volume[c], excess,
            fabs(obs[c].mass - want) / tol, off, off / (hv / 2));
-    CHECK(fabs(obs[c].area - st.volume[c]) <= layer, "cell %d: volume %.6f, the label's %.6f",
-          c + 1, obs[c].area, st.volume[c]);
+    CHECK(fabs(obs[c].volume - st.volume[c]) <= layer, "cell %d: volume %.6f, the label's %.6f",
+          c + 1, obs[c].volume, st.volume[c]);
     CHECK(fabs(obs[c].mass - want) <= tol, "cell %d: mass %.6f, expected %.6f +- %.6f", c + 1,
           obs[c].mass, want, tol);
     CHECK(off <= hv / 2, "cell %d: centre %.3e from the voxels' centroid", c + 1, off);
@@ -310,17 +310,17 @@ static void ellipsoids_qform_centred(void) {
          "h_max/2)\n", SCALE * qsize[0], SCALE * qsize[1], SCALE * qsize[2]);
   for (int c = 0; c < N_LABELS; ++c) {
     double off2 = 0;
-    const double got[3] = {obs[c].xc, obs[c].yc, obs[c].zc};
+    const double got[3] = {obs[c].centre[0], obs[c].centre[1], obs[c].centre[2]};
     for (int a = 0; a < 3; ++a) {
       const double want = st.centre[c][a] - 0.5 * (lo[a] + hi[a]) + offset[a];
       off2 += (got[a] - want) * (got[a] - want);
     }
     printf("  %d: %.2e (%.2f), volume %.6f, the label's %.6f\n", c + 1, sqrt(off2),
-           sqrt(off2) / (h_max / 2), obs[c].area, st.volume[c]);
+           sqrt(off2) / (h_max / 2), obs[c].volume, st.volume[c]);
     CHECK(sqrt(off2) <= h_max / 2, "cell %d: centre %.3e from the voxels' centroid", c + 1,
           sqrt(off2));
-    CHECK(fabs(obs[c].area - st.volume[c]) <= st.faces[c] * h_max / 2,
-          "cell %d: volume %.6f, the label's %.6f", c + 1, obs[c].area, st.volume[c]);
+    CHECK(fabs(obs[c].volume - st.volume[c]) <= st.faces[c] * h_max / 2,
+          "cell %d: volume %.6f, the label's %.6f", c + 1, obs[c].volume, st.volume[c]);
   }
 }
 

@@ -26,7 +26,7 @@ static double norm2(const double *v, int n) {
 static int step_with(const sp_mesh *mesh, const sp_layout *layout, int kind, double dt,
                      const double *old, double *state, sp_step_report *rep, double *energy,
                      double *residual_norm) {
-  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU);
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_LINEAR_SUPERLU);
   opt.line_search = kind;
   sp_solver s = make_solver_opts(mesh, layout, &opt);
   const int n = 2 * layout->n_pairs;
@@ -120,7 +120,7 @@ int main(int argc, char **argv) {
     CHECK(rel <= 1e-12, "cell %d lost mass under the line search: relative %.3g", k, rel);
   }
 
-  sp_solver_options bad = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU);
+  sp_solver_options bad = test_options(SP_SOLVER_JAC_AD, SP_LINEAR_SUPERLU);
   bad.line_search = 7;
   expect_solver_refused(&bad, "solver.line_search");
   free(old);

@@ -1,4 +1,4 @@
-/* The lineage table's building blocks (src/lineage.c) and the asymmetric
+/* The lineage table's building blocks (src/model/lineage.c) and the asymmetric
  * cut (sp_division_balance_offset with a fraction), no time stepping:
  * - an elliptical parent cut with the long and a fixed axis gives its first
  *   daughter the asked share of its mass: to 1e-9 relative with the smooth
@@ -14,15 +14,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "division.h"
-#include "error.h"
+#include "model/division.h"
+#include "public/error.h"
 #include "fixtures.h"
-#include "layout.h"
-#include "lineage.h"
-#include "mesh.h"
-#include "scene.h"
+#include "mesh/layout.h"
+#include "model/lineage.h"
+#include "mesh/mesh.h"
+#include "scene/scene.h"
 
 /** Centre and inertia integrate c >= this, as the stepper does. */
 #define WEIGHT_THRESHOLD 0.05
@@ -87,7 +87,7 @@ static void test_asymmetric_split(void) {
         CHECK(off <= allowed, "fixed %d smooth %d: share %.12f for %g (allowed %.3g)", fixed,
               smooth, share, e.fraction, allowed);
         /* the first daughter on the side the normal points away from */
-        const double c0[2] = {after[0].xc, after[0].yc}, c1[2] = {after[1].xc, after[1].yc};
+        const double c0[2] = {after[0].centre[0], after[0].centre[1]}, c1[2] = {after[1].centre[0], after[1].centre[1]};
         CHECK(dot2(c0, normal) < dot2(c1, normal), "fixed %d: the first daughter is on the "
               "normal's side", fixed);
         if (fixed) /* the user's direction */

@@ -20,10 +20,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "scene.h"
-#include "stepper.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 #define OUT "test_lineage_3d_out"
 enum { MAX_CELLS = 4, CAP = 200 };

@@ -18,9 +18,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "run.h"
+#include "public/run.h"
 
 #define SCENE SP_SOURCE_DIR "/tests/scenes/lineage_two_gen.yaml"
 #define PI 3.14159265358979323846

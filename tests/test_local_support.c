@@ -21,13 +21,13 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "scene.h"
-#include "stepper.h"
-#include "support.h"
-#include "cells.h"
-#include "layout.h"
-#include "mesh.h"
+#include "public/error.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
+#include "model/support.h"
+#include "model/cells.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
 #include "output_read.h"
 #include "scene_fixture.h"
 

@@ -38,13 +38,13 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
 #include "output_read.h"
-#include "scene.h"
-#include "stepper.h"
-#include "support.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
+#include "model/support.h"
 
 #define SCENE SP_SOURCE_DIR "/tests/scenes/local_divide_3d.yaml"
 

@@ -1,6 +1,6 @@
 /* The Jacobian as Newton applies it with the implicit shape term on
  * (sp_solver_apply_jacobian; the sparse matrix plus the low-rank part U C V^T
- * that cxx_glue/linear_low_rank.hpp solves by Woodbury), on three tanh
+ * that cxx_glue/linear/linear_low_rank.hpp solves by Woodbury), on three tanh
  * ellipses that overlap (a full layout on a 32 x 32 mesh), each with its own
  * shape gains:
  * 1. J^T is the transpose of J: <J^T x, y> = <x, J y> for random x, y, to
@@ -62,7 +62,7 @@ static problem problem_create(void) {
   CHECK_OK(sp_cells_observe(pb.mesh, pb.layout, pb.old, 0.05, obs));
   for (int k = 0; k < N_CELLS; ++k)
     birth[k] = (sp_cell_birth){.birth_mass = obs[k].mass,
-                               .Iref = {0.8 * obs[k].I1, 1.1 * obs[k].I2}};
+                               .Iref = {0.8 * obs[k].moments[0], 1.1 * obs[k].moments[1]}};
   CHECK_OK(sp_shape_coefficients(2, N_CELLS, obs, birth, (double[3]){2e5, 5e5, 0}, pb.coef));
   for (int k = 0; k < N_CELLS; ++k) pb.coef[k].threshold = 0.05;
   pb.solver = make_solver(pb.mesh, pb.layout, SP_SOLVER_JAC_AD);

@@ -1,13 +1,13 @@
 /* Mesh: rectangle and five-patch ellipse counts, geometry, quality, the
  * buffer ring, area convergence, argument checks. Each test_* function is
- * one behaviour of src/mesh.h. */
+ * one behaviour of src/mesh/mesh.h. */
 #include <stdlib.h>
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "mesh.h"
-#include "q1.h"
+#include "public/error.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 
 static const double pi = 3.14159265358979323846;
 

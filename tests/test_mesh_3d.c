@@ -26,9 +26,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "mesh.h"
-#include "q1.h"
+#include "public/error.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 
 static const double pi = 3.14159265358979323846;
 

@@ -12,7 +12,7 @@
  * Euler's error against the exact c has order 1 in dt (within 0.1).
  * Time, both dimensions: steps that are not uniform (the repeating pattern
  * 0.7, 1.3, 0.9, 1.1 of tests/test_time_order.c), through the stepper's
- * time scheme (src/time_scheme.h: BDF2 as a backward-Euler step from
+ * time scheme (src/time/time_scheme.h: BDF2 as a backward-Euler step from
  * c_hat): backward Euler order 1 and BDF2 order 2 (within 0.1), measured
  * from the differences of successive step refinements,
  * ||u_N - u_2N|| / ||u_2N - u_4N||, so the fixed spatial error of a coarse
@@ -20,7 +20,7 @@
 #include <time.h>
 
 #include "fixtures.h"
-#include "time_scheme.h"
+#include "time/time_scheme.h"
 
 #define C0 0.1
 #define AMP 0.08

@@ -18,7 +18,7 @@ int main(int argc, char **argv) {
   sp_mesh *mesh;
   sp_layout *layout;
   three_cell_problem(&mesh, &layout);
-  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU_DIST);
+  sp_solver_options opt = test_options(SP_SOLVER_JAC_AD, SP_LINEAR_SUPERLU_DIST);
   opt.ordering = SP_SOLVER_ORDER_PAIRS;
   sp_solver pairs = make_solver_opts(mesh, layout, &opt);
   opt.ordering = SP_SOLVER_ORDER_UNKNOWNS;
@@ -26,7 +26,7 @@ int main(int argc, char **argv) {
   opt.ordering = SP_SOLVER_ORDER_PAIRS;
   opt.refine = 1;
   sp_solver refined = make_solver_opts(mesh, layout, &opt);
-  sp_solver serial = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_SOLVER_SUPERLU);
+  sp_solver serial = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_LINEAR_SUPERLU);
   sp_solver solvers[N_SOLVERS] = {pairs, unknowns, serial, refined};
   const char *names[N_SOLVERS] = {"pairs", "unknowns", "serial SuperLU", "pairs, refined"};
   const int n = 2 * layout->n_pairs;

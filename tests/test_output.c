@@ -15,10 +15,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "layout.h"
-#include "output.h"
-#include "render.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "io/output.h"
+#include "io/render.h"
 #include "output_read.h"
 
 #define DIR "test_output_tmp/run/a"
@@ -169,8 +169,9 @@ int main(void) {
                               &parts[r], shape[r], r == 1 ? &seconds : NULL));
   sp_cell_obs obs[2];
   memset(obs, 0, sizeof obs);
-  obs[0].mass = 0.1 / 3.0, obs[0].xc = 0.25, obs[0].angle = -1.0 / 7.0;
-  obs[1].mass = 2.0 / 3.0, obs[1].I1 = 1e-8 / 3.0;
+  obs[0].mass = 0.1 / 3.0, obs[0].centre[0] = 0.25;
+  obs[0].axes[0][0] = cos(-1.0 / 7.0), obs[0].axes[0][1] = sin(-1.0 / 7.0);
+  obs[1].mass = 2.0 / 3.0, obs[1].moments[0] = 1e-8 / 3.0;
   CHECK_OK(sp_output_cells(out, 0, 0.0, 2, obs, NULL));
   CHECK_OK(sp_output_cells(out, 10, tv[1], 2, obs, NULL));
 
@@ -261,7 +262,7 @@ int main(void) {
       for (int j = 0; j < 3; ++j) strtod(end + 1, &end);
       double angle = strtod(end + 1, &end);
       CHECK(cell == 1 && mass == obs[0].mass && xc == 0.25 &&
-                angle == obs[0].angle,
+                angle == sp_cells_obs_angle(&obs[0], 2),
             "cells.csv row 1: cell %ld mass %.17g angle %.17g", cell, mass,
             angle);
       free(csv);

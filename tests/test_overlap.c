@@ -3,10 +3,10 @@
  * case tests nothing), the stepper must shrink dt, retry, never accept an
  * unconverged step, grow dt back and reach t_end. */
 #include "check.h"
-#include "error.h"
-#include "scene.h"
+#include "public/error.h"
+#include "scene/scene.h"
 #include "softpack_solver.h"
-#include "stepper.h"
+#include "run/stepper.h"
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);

@@ -1,4 +1,4 @@
-/* The node partition of MPI runs (src/partition.h): the RCB order is a
+/* The node partition of MPI runs (src/mesh/partition.h): the RCB order is a
  * permutation and renumbering keeps the mesh; on a 3:1 rectangle, ranges of
  * the RCB order cut the element edges of straight lines across the short
  * side and ranges of the row-by-row numbering those of lines along the long
@@ -10,10 +10,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
-#include "partition.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "mesh/partition.h"
 
 /** Element edges whose two nodes belong to different ranks (each interior
  *  edge is counted once per element side: a proxy for the interface). */

@@ -12,10 +12,10 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "scene.h"
-#include "stepper.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 static sp_run_summary run(const char *scene_file, const char *predictor, const char *out) {
   char path[1024], set_pred[64];

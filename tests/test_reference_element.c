@@ -15,9 +15,9 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "error.h"
-#include "mesh.h"
-#include "q1.h"
+#include "public/error.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
 
 static double uniform(unsigned long long *s) { /* in [-1, 1) */
   *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;

@@ -22,12 +22,12 @@
 #include <sys/stat.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "partition.h"
-#include "run_options.h"
-#include "scene.h"
-#include "stepper.h"
+#include "mesh/partition.h"
+#include "run/run_options.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 enum { MAX_CELLS = 4 };
 

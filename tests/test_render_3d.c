@@ -1,4 +1,4 @@
-/* Pictures of 3D states (src/render.c, issue 29):
+/* Pictures of 3D states (src/io/render.c, issue 29):
  *  - the c = 1/2 surface (sp_render_level_surface) of a sphere field (tanh
  *    profile) on box meshes of 8, 16, 32 hexahedra a side is closed (every
  *    edge in exactly two triangles, once each way: consistently turned),
@@ -28,10 +28,10 @@
 
 #include "check.h"
 #include "command.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
-#include "render.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "io/render.h"
 
 static const double pi = 3.14159265358979323846;
 

@@ -1,4 +1,4 @@
-/* The public run entry point (src/run.h): a scene given as text with an
+/* The public run entry point (src/public/run.h): a scene given as text with an
  * override, a step callback that sees every accepted step in order (the
  * cells' observables with it) and stops the run after step 3: the run
  * returns SP_OK with summary.stopped, and energy.csv and the fields end at
@@ -8,7 +8,7 @@
 
 #include "check.h"
 #include "output_read.h"
-#include "run.h"
+#include "public/run.h"
 
 static const char scene[] =
     "mesh: {type: rectangle, x0: 0, y0: 0, x1: 1, y1: 1, nx: 16, ny: 16}\n"

@@ -1,4 +1,4 @@
-/* test_scene: the scene file reader (src/scene.c).
+/* test_scene: the scene file reader (src/scene/scene.c).
  *
  * - a minimal scene gets every default of the key table;
  * - a scene setting every key gets every value;
@@ -22,9 +22,9 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "run_options.h"
-#include "scene.h"
+#include "public/error.h"
+#include "run/run_options.h"
+#include "scene/scene.h"
 
 #ifndef SP_SOURCE_DIR
 #error "compile with -DSP_SOURCE_DIR=\"<repository root>\""
@@ -195,17 +195,17 @@ static void test_linear_auto(void) {
     int linear;
     double tol;
   } cases[] = {
-      {"tests/scenes/ellipse_minimal.yaml", {NULL, NULL}, SP_SOLVER_MUMPS, 1e-10},
+      {"tests/scenes/ellipse_minimal.yaml", {NULL, NULL}, SP_LINEAR_MUMPS, 1e-10},
       {"tests/scenes/ellipse_minimal.yaml", {"solver.linear=gmres_ilu", NULL},
-       SP_SOLVER_GMRES_ILU, 1e-10},
+       SP_LINEAR_GMRES_ILU, 1e-10},
       {"tests/scenes/ellipse_minimal.yaml", {"solver.linear=gmres_cells", NULL},
-       SP_SOLVER_GMRES_CELLS, 1e-4},
-      {"tests/scenes/restart_3d.yaml", {NULL, NULL}, SP_SOLVER_GMRES_CELLS, 1e-4},
-      {"tests/scenes/restart_3d.yaml", {"solver.krylov_tol=1e-6", NULL}, SP_SOLVER_GMRES_CELLS,
+       SP_LINEAR_GMRES_CELLS, 1e-4},
+      {"tests/scenes/restart_3d.yaml", {NULL, NULL}, SP_LINEAR_GMRES_CELLS, 1e-4},
+      {"tests/scenes/restart_3d.yaml", {"solver.krylov_tol=1e-6", NULL}, SP_LINEAR_GMRES_CELLS,
        1e-6},
       {"tests/scenes/divide_3d.yaml", {"solver.linear=auto", "solver.krylov_tol=1e-6"},
-       SP_SOLVER_GMRES_CELLS, 1e-6},
-      {"tests/scenes/divide_3d.yaml", {"solver.linear=mumps", NULL}, SP_SOLVER_MUMPS, 1e-10},
+       SP_LINEAR_GMRES_CELLS, 1e-6},
+      {"tests/scenes/divide_3d.yaml", {"solver.linear=mumps", NULL}, SP_LINEAR_MUMPS, 1e-10},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
     char path[PATH_SIZE];

@@ -21,8 +21,8 @@
 
 #include "check.h"
 #include "command.h"
-#include "error.h"
-#include "scene.h"
+#include "public/error.h"
+#include "scene/scene.h"
 
 static const char good_mesh[] =
     "mesh: {type: box, x0: 0, y0: 0, z0: -0.1, x1: 0.6, y1: 0.5, z1: 0.4, nx: 6, ny: 5, nz: 5}\n";

@@ -1,4 +1,4 @@
-/* The shape penalty (src/shape.c, MODEL.md "Shape penalty"):
+/* The shape penalty (src/model/shape.c, MODEL.md "Shape penalty"):
  * - inertia tensors of a disk, an ellipse and a rotated ellipse with a thin
  *   tanh profile against the profile's exact integrals, on three meshes
  *   (second order in h), and the area inside c = 1/2 against pi a b;
@@ -17,8 +17,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "division.h"
-#include "scene.h"
+#include "model/division.h"
+#include "scene/scene.h"
 #include "shape_fixtures.h"
 
 #define PI 3.14159265358979323846
@@ -64,18 +64,18 @@ static void test_tensors(void) {
       set_ellipse(mesh, layout, state, 0, xc, yc, a, b, phi, shapes[s].eps);
       sp_cell_obs obs;
       CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &obs));
-      const double got[3] = {obs.Ixx, obs.Iyy, obs.Ixy};
+      const double got[3] = {obs.inertia[0][0], obs.inertia[1][1], obs.inertia[0][1]};
       error[m] = 0;
       for (int c = 0; c < 3; ++c) error[m] = fmax(error[m], fabs(got[c] - exact[c]) / Su);
       /* v1 is the larger moment's: perpendicular to the long axis */
       const double angle_error =
-          a > b ? asin(fmin(1.0, fabs(obs.v1[0] * cs + obs.v1[1] * sn))) : 0.0;
+          a > b ? asin(fmin(1.0, fabs(obs.axes[0][0] * cs + obs.axes[0][1] * sn))) : 0.0;
       printf("  %-32s | %4d | %22.3e | %.4f (%.4f) | %.2e\n", shapes[s].name, meshes[m],
-             error[m], obs.I1 / obs.I2, Su / Sv, angle_error);
+             error[m], obs.moments[0] / obs.moments[1], Su / Sv, angle_error);
       /* the c = 1/2 level set is rho = 1: the area inside is pi a b */
-      const double area_error = fabs(obs.area - PI * a * b) / (PI * a * b);
+      const double area_error = fabs(obs.volume - PI * a * b) / (PI * a * b);
       printf("  %-32s | %4d | area (c >= 1/2) %.6f, pi a b %.6f: relative error %.1e\n",
-             shapes[s].name, meshes[m], obs.area, PI * a * b, area_error);
+             shapes[s].name, meshes[m], obs.volume, PI * a * b, area_error);
       if (m == 2) {
         CHECK(area_error < 2e-3, "%s: area off by %.3g relative", shapes[s].name, area_error);
         CHECK(error[m] < 2e-4, "%s: tensor error %.3g on the finest mesh", shapes[s].name,
@@ -132,7 +132,7 @@ static void test_derivatives(void) {
   sp_cell_obs obs;
   CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &obs));
   printf("derivatives on an elongated cell (I1/I2 = %.3f, 40x40 mesh, threshold 0):\n",
-         obs.I1 / obs.I2);
+         obs.moments[0] / obs.moments[1]);
   /* (a) int N_j Ihat^i against central differences of I^i */
   const double step = 1e-4;
   double worst[2] = {0, 0}, scale[2] = {0, 0};
@@ -140,9 +140,9 @@ static void test_derivatives(void) {
     const int p = sp_layout_pair(layout, 0, j);
     sp_cell_obs plus, minus;
     observe_plus_minus(mesh, layout, state, p, step, &plus, &minus);
-    const double fd[2] = {(plus.I1 - minus.I1) / (2 * step), (plus.I2 - minus.I2) / (2 * step)};
-    const double an[2] = {node_integral_ihat(mesh, j, obs.xc, obs.yc, obs.v1),
-                          node_integral_ihat(mesh, j, obs.xc, obs.yc, obs.v2)};
+    const double fd[2] = {(plus.moments[0] - minus.moments[0]) / (2 * step), (plus.moments[1] - minus.moments[1]) / (2 * step)};
+    const double an[2] = {node_integral_ihat(mesh, j, obs.centre[0], obs.centre[1], obs.axes[0]),
+                          node_integral_ihat(mesh, j, obs.centre[0], obs.centre[1], obs.axes[1])};
     for (int i = 0; i < 2; ++i) {
       worst[i] = fmax(worst[i], fabs(fd[i] - an[i]));
       scale[i] = fmax(scale[i], fabs(an[i]));
@@ -158,7 +158,7 @@ static void test_derivatives(void) {
 
   /* (b) the glue: R_mu(with shape) - R_mu(without) = -dE_shape/dc_j */
   const double delta1 = 3e4, delta2 = 7e4;
-  sp_cell_birth birth = {.birth_mass = obs.mass, .Iref = {0.9 * obs.I1, 1.2 * obs.I2}};
+  sp_cell_birth birth = {.birth_mass = obs.mass, .Iref = {0.9 * obs.moments[0], 1.2 * obs.moments[1]}};
   sp_shape_coef coef;
   CHECK_OK(sp_shape_coefficients(2, 1, &obs, &birth, (double[3]){delta1, delta2, 0}, &coef));
   sp_solver solver = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
@@ -202,11 +202,12 @@ static void force_tensor(const sp_shape_coef *s, double t[3]) {
 
 /** Observables with given principal moments and v1 at angle theta. */
 static sp_cell_obs make_obs(double I1, double I2, double theta) {
-  sp_cell_obs o = {.mass = 1, .mass_core = 1, .xc = 0.3, .yc = 0.2, .I1 = I1, .I2 = I2};
-  o.v1[0] = cos(theta);
-  o.v1[1] = sin(theta);
-  o.v2[0] = -o.v1[1];
-  o.v2[1] = o.v1[0];
+  sp_cell_obs o = {.mass = 1, .mass_core = 1, .centre = {0.3, 0.2}, .moments = {I1, I2},
+                   .long_axis = 1};
+  o.axes[0][0] = cos(theta);
+  o.axes[0][1] = sin(theta);
+  o.axes[1][0] = -o.axes[0][1];
+  o.axes[1][1] = o.axes[0][0];
   return o;
 }
 
@@ -248,7 +249,7 @@ static void test_round(void) {
     sp_cell_obs o = make_obs(I * (1 + e), I * (1 - e), 0.3);
     sp_shape_coef t;
     CHECK_OK(sp_shape_coefficients(2, 1, &o, &birth, (double[3]){delta1, delta2, 0}, &t));
-    const double e1 = 2 * delta1 * (birth.Iref[0] - o.I1), e2 = 2 * delta2 * (birth.Iref[1] - o.I2);
+    const double e1 = 2 * delta1 * (birth.Iref[0] - o.moments[0]), e2 = 2 * delta2 * (birth.Iref[1] - o.moments[1]);
     const double bound = fmax(fabs(e1), fabs(e2));
     const int bounded = fabs(t.coef[0]) <= bound * (1 + 1e-14) &&
                         fabs(t.coef[1]) <= bound * (1 + 1e-14);
@@ -305,16 +306,16 @@ static void test_round(void) {
   sp_cell_obs obs;
   CHECK_OK(sp_cells_observe(mesh, layout, state, 0.05, &obs));
   const sp_cell_birth disk_birth = {.birth_mass = obs.mass_core,
-                                    .Iref = {0.8 * obs.I1, 1.2 * obs.I2}};
+                                    .Iref = {0.8 * obs.moments[0], 1.2 * obs.moments[1]}};
   sp_solver solver = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
   const double e0 = energy_total(solver, &model, state) +
                     sp_shape_energy(1, &obs, &disk_birth, (double[3]){delta1, delta2, 0});
   printf("  disk R = 0.1 on a 64x64 mesh, (I1 - I2)/(I1 + I2) = %.1e, Iref = (0.8, 1.2) I:\n",
-         (obs.I1 - obs.I2) / (obs.I1 + obs.I2));
+         (obs.moments[0] - obs.moments[1]) / (obs.moments[0] + obs.moments[1]));
   printf("    step | energy (CH + shape) | I1/I2    | coef1     | coef2     | dPi_CH     | "
          "-dL\n");
   printf("    %4d | %19.10g | %.6f |           |           |            |\n", 0, e0,
-         obs.I1 / obs.I2);
+         obs.moments[0] / obs.moments[1]);
   int finite = 1;
   double *with = malloc(n_values * sizeof(double)), *without = malloc(n_values * sizeof(double));
   for (int n = 1; n <= 5; ++n) {
@@ -340,7 +341,7 @@ static void test_round(void) {
     for (size_t i = 0; i < n_values; ++i) finite &= isfinite(state[i]) != 0;
     finite &= isfinite(e) && isfinite(sc.coef[0]) && isfinite(sc.coef[1]);
     printf("    %4d | %19.10g | %.6f | %9.4g | %9.4g | %10.3e | %10.3e\n", n, e,
-           obs.I1 / obs.I2, sc.coef[0], sc.coef[1], pi_new - pi_old, minus_dl);
+           obs.moments[0] / obs.moments[1], sc.coef[0], sc.coef[1], pi_new - pi_old, minus_dl);
     /* round-off: the energies are sums over elements (1e-13 relative) */
     CHECK(pi_new - pi_old <= minus_dl + 1e-12 * fabs(pi_old),
           "round disk, step %d: Pi_CH changed by %.6g, the law allows %.6g", n, pi_new - pi_old,
@@ -349,7 +350,7 @@ static void test_round(void) {
   free(with);
   free(without);
   CHECK(finite, "non-finite values in the round-disk steps");
-  CHECK(obs.I1 / obs.I2 < 1.01, "round disk: became elongated (I1/I2 = %.4f)", obs.I1 / obs.I2);
+  CHECK(obs.moments[0] / obs.moments[1] < 1.01, "round disk: became elongated (I1/I2 = %.4f)", obs.moments[0] / obs.moments[1]);
   sp_solver_destroy(&solver);
   one_cell_destroy(&o);
 }
@@ -361,7 +362,7 @@ static double evolve_i2(double delta2, double iref2_factor, int steps, double th
                         double background, double *i2_start, double *i2_ref) {
   const relax_result r = relax_ellipse((relax_setup){
       .delta2 = delta2, .iref2_factor = iref2_factor, .threshold = threshold,
-      .background = background, .linear = SP_SOLVER_SUPERLU, .steps = steps, .dt = 2e-4});
+      .background = background, .linear = SP_LINEAR_SUPERLU, .steps = steps, .dt = 2e-4});
   CHECK(r.ok, "step %d: %s", r.steps_done + 1, r.failed.reason);
   *i2_start = r.i2_start;
   *i2_ref = r.i2_ref;

@@ -1,4 +1,4 @@
-/* The shape penalty on the three principal moments of a 3D cell (src/shape.h,
+/* The shape penalty on the three principal moments of a 3D cell (src/model/shape.h,
  * docs/3d.md "Shape term in 3D"):
  * 1. on a tanh ellipsoid with three distinct moments (rotated, on a box of
  *    hexahedra): the glue's Ihat_i = |v_i x Xb|^2 integrated against N_j is
@@ -36,19 +36,19 @@
 #include <string.h>
 
 #include "check.h"
-#include "division.h"
-#include "scene.h"
+#include "model/division.h"
+#include "scene/scene.h"
 #include "shape_fixtures.h"
-#include "stepper.h"
+#include "run/stepper.h"
 
 /** The moment I^(i+1) of observables @p o. */
 static double moment(const sp_cell_obs *o, int i) {
-  return i == 0 ? o->I1 : i == 1 ? o->I2 : o->I3;
+  return i == 0 ? o->moments[0] : i == 1 ? o->moments[1] : o->moments[2];
 }
 
 /** The unit eigenvector of I^(i+1). */
 static const double *axis(const sp_cell_obs *o, int i) {
-  return i == 0 ? o->v1 : i == 1 ? o->v2 : o->v3;
+  return i == 0 ? o->axes[0] : i == 1 ? o->axes[1] : o->axes[2];
 }
 
 /** A box of n^3 hexahedra on [0, L]^3 with one cell (full layout). */
@@ -73,7 +73,7 @@ static void test_derivatives(void) {
   sp_cell_obs obs;
   CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &obs));
   printf("derivatives on a rotated ellipsoid (20^3 hexahedra, threshold 0): I = %.4e, %.4e, "
-         "%.4e\n", obs.I1, obs.I2, obs.I3);
+         "%.4e\n", obs.moments[0], obs.moments[1], obs.moments[2]);
   sp_solver solver = make_solver(mesh, layout, SP_SOLVER_JAC_AD);
   double *without = malloc(n_values * sizeof(double)), *with = malloc(n_values * sizeof(double));
   sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = state};
@@ -84,7 +84,7 @@ static void test_derivatives(void) {
   /* (a) unit coefficient on moment i: the term -coef_i Ihat_i in mu_k
    * enters R_mu = int N (mu - ...) as +int N_j Ihat_i */
   for (int i = 0; i < 3; ++i) {
-    sp_shape_coef unit = {.xc = obs.xc, .yc = obs.yc, .zc = obs.zc};
+    sp_shape_coef unit = {.xc = obs.centre[0], .yc = obs.centre[1], .zc = obs.centre[2]};
     for (int m = 0; m < 3; ++m)
       for (int d = 0; d < 3; ++d) unit.v[m][d] = axis(&obs, m)[d];
     unit.coef[i] = 1.0;
@@ -109,10 +109,10 @@ static void test_derivatives(void) {
   /* (b) the coefficients of three moduli: the mu term is -dE/dc */
   const double delta[3] = {3e4, 7e4, 5e4};
   sp_cell_birth birth = {.birth_mass = obs.mass,
-                         .Iref = {0.9 * obs.I1, 1.2 * obs.I2, 0.8 * obs.I3}};
-  const double trace = obs.I1 + obs.I2 + obs.I3;
+                         .Iref = {0.9 * obs.moments[0], 1.2 * obs.moments[1], 0.8 * obs.moments[2]}};
+  const double trace = obs.moments[0] + obs.moments[1] + obs.moments[2];
   printf("  relative gaps (I1 - I2, I2 - I3) / tr I = %.3f, %.3f (blend below %g)\n",
-         (obs.I1 - obs.I2) / trace, (obs.I2 - obs.I3) / trace, SP_SHAPE_ROUND_TOL);
+         (obs.moments[0] - obs.moments[1]) / trace, (obs.moments[1] - obs.moments[2]) / trace, SP_SHAPE_ROUND_TOL);
   sp_shape_coef coef;
   CHECK_OK(sp_shape_coefficients(3, 1, &obs, &birth, delta, &coef));
   data.shape = &coef;
@@ -142,12 +142,12 @@ static void test_derivatives(void) {
 
 /** Observables with moments I[3] and eigenvectors the rows of @p axes. */
 static sp_cell_obs make_obs(const double I[3], const double axes[3][3]) {
-  sp_cell_obs o = {.mass = 1, .mass_core = 1, .xc = 0.3, .yc = 0.2, .zc = 0.1,
-                   .I1 = I[0], .I2 = I[1], .I3 = I[2]};
+  sp_cell_obs o = {.mass = 1, .mass_core = 1, .centre = {0.3, 0.2, 0.1},
+                   .moments = {I[0], I[1], I[2]}, .long_axis = 2};
   for (int d = 0; d < 3; ++d) {
-    o.v1[d] = axes[0][d];
-    o.v2[d] = axes[1][d];
-    o.v3[d] = axes[2][d];
+    o.axes[0][d] = axes[0][d];
+    o.axes[1][d] = axes[1][d];
+    o.axes[2][d] = axes[2][d];
   }
   return o;
 }
@@ -270,8 +270,8 @@ static void test_round(void) {
     }
     /* continuity: move the middle moment by 1e-9 of the trace */
     sp_cell_obs o2 = o;
-    o2.I2 += 1e-9 * tr;
-    if (o2.I2 > o2.I1) o2.I2 = o2.I1;
+    o2.moments[1] += 1e-9 * tr;
+    if (o2.moments[1] > o2.moments[0]) o2.moments[1] = o2.moments[0];
     CHECK_OK(sp_shape_coefficients(3, 1, &o2, &birth, delta, &s2));
     worst_cont = fmax(worst_cont, tensor_distance(&s, &s2) / spread);
   }
@@ -341,16 +341,16 @@ static prolate_result prolate_steps(double delta3, int implicit, int relax, int 
   sp_cell_obs obs;
   CHECK_OK(sp_cells_observe(mesh, layout, state, threshold, &obs));
   sp_cell_birth birth = {.birth_mass = obs.mass_core};
-  sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_SOLVER_MUMPS);
+  sp_solver solver = make_solver_with(mesh, layout, SP_SOLVER_JAC_AD, SP_LINEAR_MUMPS);
   /* delta1 != delta2 on the equal pair: their coefficients differ, and
    * only the blend keeps the force isotropic in their eigenspace */
   const double delta[3] = {2e5, 6e5, delta3};
   for (int step = 0; step < relax + steps; ++step) {
     if (step == relax) {
-      birth.Iref[0] = obs.I1;
-      birth.Iref[1] = obs.I2;
-      birth.Iref[2] = 0.85 * obs.I3;
-      r.i3_start = obs.I3;
+      birth.Iref[0] = obs.moments[0];
+      birth.Iref[1] = obs.moments[1];
+      birth.Iref[2] = 0.85 * obs.moments[2];
+      r.i3_start = obs.moments[2];
       r.i3_ref = birth.Iref[2];
     }
     const int on = step >= relax && delta3 > 0;
@@ -365,11 +365,11 @@ static prolate_result prolate_steps(double delta3, int implicit, int relax, int 
     const double mass_before = obs.mass;
     CHECK_OK(sp_cells_observe(mesh, layout, state, threshold, &obs));
     r.mass_drift = fmax(r.mass_drift, fabs(obs.mass - mass_before) / fabs(mass_before));
-    r.finite &= isfinite(obs.I1) && isfinite(obs.I2) && isfinite(obs.I3);
+    r.finite &= isfinite(obs.moments[0]) && isfinite(obs.moments[1]) && isfinite(obs.moments[2]);
   }
-  r.i3_end = obs.I3;
-  r.i1_end = obs.I1;
-  r.i2_end = obs.I2;
+  r.i3_end = obs.moments[2];
+  r.i1_end = obs.moments[0];
+  r.i2_end = obs.moments[1];
   sp_solver_destroy(&solver);
   free(state);
   free(old);
@@ -432,7 +432,7 @@ static void test_implicit_jacobian(void) {
   CHECK_OK(sp_cells_observe(mesh, layout, old, 0.05, obs));
   for (int k = 0; k < 2; ++k)
     birth[k] = (sp_cell_birth){.birth_mass = obs[k].mass,
-                               .Iref = {0.8 * obs[k].I1, 1.1 * obs[k].I2, 0.9 * obs[k].I3}};
+                               .Iref = {0.8 * obs[k].moments[0], 1.1 * obs[k].moments[1], 0.9 * obs[k].moments[2]}};
   sp_shape_coef coef[2];
   CHECK_OK(sp_shape_coefficients(3, 2, obs, birth, (double[3]){2e5, 5e5, 3e5}, coef));
   for (int k = 0; k < 2; ++k) coef[k].threshold = 0.05;

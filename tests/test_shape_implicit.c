@@ -44,7 +44,7 @@ static void test_residual(void) {
   CHECK_OK(sp_cells_observe(mesh, layout, state, 0.0, &obs_new));
   const double delta1 = 3e5, delta2 = 7e5;
   const sp_cell_birth birth = {.birth_mass = obs_old.mass,
-                               .Iref = {0.9 * obs_old.I1, 1.2 * obs_old.I2}};
+                               .Iref = {0.9 * obs_old.moments[0], 1.2 * obs_old.moments[1]}};
   sp_shape_coef coef;
   CHECK_OK(sp_shape_coefficients(2, 1, &obs_old, &birth, (double[3]){delta1, delta2, 0}, &coef));
   coef.threshold = 0.0;
@@ -80,7 +80,7 @@ static void test_residual(void) {
     scale = fmax(scale, fabs(dE));
   }
   printf("residual: minor axis +%.0f%% (I2 %.4e -> %.4e), delta = (%g, %g):\n", 100 * growth,
-         obs_old.I2, obs_new.I2, delta1, delta2);
+         obs_old.moments[1], obs_new.moments[1], delta1, delta2);
   printf("  max |R_mu(with) - R_mu(without) + dE_shape/dc(new state)| / max |dE/dc|: "
          "implicit %.2e, explicit %.2e; schemes at c^n differ by %.1e\n",
          err_implicit / scale, err_explicit / scale, same);
@@ -141,8 +141,8 @@ static void test_newton(int linear, const char *name) {
 static void test_stiff(void) {
   const double delta2 = 1e7, dt = 2e-4;
   const int steps = 20;
-  relax_result imp = relax(delta2, 1, steps, dt, SP_SOLVER_SUPERLU);
-  relax_result exp_ = relax(delta2, 0, steps, dt, SP_SOLVER_SUPERLU);
+  relax_result imp = relax(delta2, 1, steps, dt, SP_LINEAR_SUPERLU);
+  relax_result exp_ = relax(delta2, 0, steps, dt, SP_LINEAR_SUPERLU);
   printf("stiff: delta2 = %g, %d steps of %g, no source, I2 start %.4e, I2,ref %.4e:\n", delta2,
          steps, dt, imp.i2_start, imp.i2_ref);
   printf("  implicit: %d steps, %d Newton its, energy %.6g -> %.6g, largest rise %.1e, "
@@ -162,8 +162,8 @@ static void test_stiff(void) {
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   test_residual();
-  test_newton(SP_SOLVER_SUPERLU, "superlu");
-  test_newton(SP_SOLVER_SUPERLU_DIST, "superlu_dist");
+  test_newton(SP_LINEAR_SUPERLU, "superlu");
+  test_newton(SP_LINEAR_SUPERLU_DIST, "superlu_dist");
   test_stiff();
   MPI_Finalize();
   TEST_DONE();

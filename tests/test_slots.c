@@ -11,13 +11,13 @@
  * - the mesh's cached Q1 geometry is sp_q1_point's, bit for bit. */
 #include <string.h>
 
-#include "cells.h"
+#include "model/cells.h"
 #include "check.h"
-#include "error.h"
-#include "layout.h"
-#include "mesh.h"
-#include "q1.h"
-#include "support.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "mesh/mesh.h"
+#include "mesh/q1.h"
+#include "model/support.h"
 
 /** 1 if the two layouts number the same pairs. */
 static int same_layout(const sp_layout *a, const sp_layout *b) {

@@ -1,13 +1,13 @@
-/* The growth source (src/source.c, paper algorithm 3): nodal s_bar where
+/* The growth source (src/model/source.c, paper algorithm 3): nodal s_bar where
  * c^n >= 1/2 and the cell's source is on, 0 elsewhere, per (cell, node)
  * pair; the switch-off needs both N >= N_max and m / m^0 > 1.1, and lasts. */
 #include <stdlib.h>
 
 #include "check.h"
-#include "division.h"
-#include "error.h"
-#include "layout.h"
-#include "source.h"
+#include "model/division.h"
+#include "public/error.h"
+#include "mesh/layout.h"
+#include "model/source.h"
 
 /* The fill on a full layout: nodal values follow c^n (>= 1/2 is inside,
  * including exactly 1/2), per cell, and a cell switched off gets 0. */

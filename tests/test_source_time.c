@@ -1,4 +1,4 @@
-/* The growth source in time under BDF2 (source.indicator, src/step.c): one
+/* The growth source in time under BDF2 (source.indicator, src/run/step.c): one
  * cell growing by 1.4x (tests/scenes/grow_one.yaml, fixed steps
  * dt = T / N). The source is s_bar on the nodes inside omega_k (c_k >= 1/2).
  * Taken from c^n (`previous`, the paper's algorithm 3) the indicator lags
@@ -23,10 +23,10 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "error.h"
+#include "public/error.h"
 #include "output_read.h"
-#include "scene.h"
-#include "stepper.h"
+#include "scene/scene.h"
+#include "run/stepper.h"
 
 #define T_END 0.002
 #define S_BAR 200.0

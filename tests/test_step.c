@@ -20,12 +20,12 @@
 #include <string.h>
 
 #include "check.h"
-#include "division.h"
-#include "error.h"
-#include "events.h"
-#include "scene.h"
+#include "model/division.h"
+#include "public/error.h"
+#include "run/events.h"
+#include "scene/scene.h"
 #include "scene_fixture.h"
-#include "step.h"
+#include "run/step.h"
 
 #define BASE                                                                    \
   "mesh: {type: rectangle, x0: 0, y0: 0, x1: 1, y1: 1, nx: 24, ny: 24}\n"       \
@@ -154,7 +154,7 @@ static void landing(void) {
   CHECK_OK(sp_step_complete(run, &a));
   double closest = INFINITY;
   for (int k = 0; k < run->layout->n_cells; ++k) {
-    const double threshold = sp_division_threshold(&run->division, &run->cells.birth[k]);
+    const double threshold = sp_division_threshold(&run->opt.division.rule, &run->cells.birth[k]);
     closest = fmin(closest, fabs(run->cells.obs[k].mass_core / threshold - 1));
   }
   CHECK(closest <= SP_MASS_LANDING_TOLERANCE,

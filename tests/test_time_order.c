@@ -1,5 +1,5 @@
 /* Orders in time with steps that are not uniform: backward Euler 1, BDF2 2
- * (within 0.1), through the time scheme the stepper uses (src/time_scheme.h:
+ * (within 0.1), through the time scheme the stepper uses (src/time/time_scheme.h:
  * the history, BDF2 as a backward-Euler step from c_hat), on a manufactured
  * solution of the two-cell equations with repulsion:
  *   c_k(x, y, t) = C0 + A g(t) phi_k(x, y),  phi_1 = cos(pi x) cos(pi y),
@@ -14,7 +14,7 @@
  * cell's mass is conserved to round-off by both schemes on the same
  * sequences. */
 #include "fixtures.h"
-#include "time_scheme.h"
+#include "time/time_scheme.h"
 
 #define C0 0.1
 #define AMP 0.08

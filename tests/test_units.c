@@ -12,8 +12,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "error.h"
-#include "output.h"
+#include "public/error.h"
+#include "io/output.h"
 
 static const char want_2d[] =
     "file,column,unit,scale\n"

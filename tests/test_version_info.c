@@ -9,7 +9,7 @@
 
 #include "check.h"
 #include "command.h"
-#include "scene.h"
+#include "scene/scene.h"
 #include "softpack_solver.h"
 
 /** The text after "key: " up to the end of its line, or "" if absent. */
@@ -47,7 +47,7 @@ int main(int argc, char **argv) {
   CHECK(strcmp(value, SP_TRILINOS_VERSION) == 0, "Trilinos '%s', want '%s'", value,
         SP_TRILINOS_VERSION);
   /* Debian's Trilinos serves every solver the scene accepts. */
-  for (int kind = SP_LINEAR_SUPERLU; kind <= SP_LINEAR_LAST; ++kind) {
+  for (int kind = 0; kind < SP_LINEAR_COUNT; ++kind) {
     char key[64];
     snprintf(key, sizeof key, "  %s ", sp_scene_linear_name((sp_linear_kind)kind));
     line_after(out, key, value, sizeof value);
@@ -57,19 +57,19 @@ int main(int argc, char **argv) {
   /* klu2 is served by Amesos2, klu by SuiteSparse's own KLU and mumps by
    * MUMPS' own C interface (no Amesos v1: issue 31): not one library twice */
   const char *klu2 = NULL, *klu = NULL;
-  CHECK(sp_solver_linear_backend(SP_SOLVER_KLU2, &klu2) == 1 && klu2 &&
+  CHECK(sp_solver_linear_backend(SP_LINEAR_KLU2, &klu2) == 1 && klu2 &&
             strstr(klu2, "Amesos2") != NULL,
         "klu2 is served by '%s', want Amesos2", klu2 ? klu2 : "(none)");
-  CHECK(sp_solver_linear_backend(SP_SOLVER_KLU, &klu) == 1 && klu &&
+  CHECK(sp_solver_linear_backend(SP_LINEAR_KLU, &klu) == 1 && klu &&
             strstr(klu, "SuiteSparse") != NULL && strstr(klu, "Amesos") == NULL,
         "klu is served by '%s', want SuiteSparse's KLU", klu ? klu : "(none)");
   const char *mumps = NULL;
-  CHECK(sp_solver_linear_backend(SP_SOLVER_MUMPS, &mumps) == 1 && mumps &&
+  CHECK(sp_solver_linear_backend(SP_LINEAR_MUMPS, &mumps) == 1 && mumps &&
             strstr(mumps, "MUMPS") != NULL && strstr(mumps, "Amesos") == NULL,
         "mumps is served by '%s', want MUMPS' own interface", mumps ? mumps : "(none)");
   /* gmres_ilu: Belos and Ifpack2 (no AztecOO, Ifpack: issue 31) */
   const char *gmres = NULL;
-  CHECK(sp_solver_linear_backend(SP_SOLVER_GMRES_ILU, &gmres) == 1 && gmres &&
+  CHECK(sp_solver_linear_backend(SP_LINEAR_GMRES_ILU, &gmres) == 1 && gmres &&
             strstr(gmres, "Belos") != NULL && strstr(gmres, "Ifpack2") != NULL &&
             strstr(gmres, "AztecOO") == NULL,
         "gmres_ilu is served by '%s', want Belos and Ifpack2", gmres ? gmres : "(none)");

@@ -1,0 +1,50 @@
+#include "model/registry.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "public/error.h"
+
+/** One per-cell array from @p n_old to @p n entries (new ones zeroed). */
+static int resize_array(void **ptr, size_t elem, int n_old, int n) {
+  void *p = realloc(*ptr, elem * (size_t)(n > 0 ? n : 1));
+  SP_CHECK(p, SP_ERR_MEMORY, "out of memory for %d cells", n);
+  if (n > n_old) memset((char *)p + elem * (size_t)n_old, 0, elem * (size_t)(n - n_old));
+  *ptr = p;
+  return SP_OK;
+}
+
+int sp_registry_resize(sp_registry *reg, int n) {
+  const int n_old = reg->obs ? reg->n : 0;
+  if (reg->obs && n == n_old) return SP_OK; /* (a support change: the arrays stay put) */
+  SP_CALL(resize_array((void **)&reg->obs, sizeof *reg->obs, n_old, n));
+  SP_CALL(resize_array((void **)&reg->birth, sizeof *reg->birth, n_old, n));
+  SP_CALL(resize_array((void **)&reg->source_on, sizeof *reg->source_on, n_old, n));
+  SP_CALL(resize_array((void **)&reg->division_skipped, sizeof *reg->division_skipped, n_old, n));
+  SP_CALL(resize_array((void **)&reg->divided_now, sizeof *reg->divided_now, n_old, n));
+  SP_CALL(resize_array((void **)&reg->obs_new, sizeof *reg->obs_new, n_old, n));
+  SP_CALL(resize_array((void **)&reg->core_mass_old, sizeof *reg->core_mass_old, n_old, n));
+  SP_CALL(resize_array((void **)&reg->core_mass, sizeof *reg->core_mass, n_old, n));
+  SP_CALL(resize_array((void **)&reg->divisions, sizeof *reg->divisions, n_old, n));
+  SP_CALL(resize_array((void **)&reg->shape, sizeof *reg->shape, n_old, n));
+  SP_CALL(resize_array((void **)&reg->name, sizeof *reg->name, n_old, n));
+  SP_CALL(resize_array((void **)&reg->cut_normal, sizeof *reg->cut_normal, n_old, n));
+  reg->n = n;
+  return SP_OK;
+}
+
+void sp_registry_free(sp_registry *reg) {
+  free(reg->obs);
+  free(reg->birth);
+  free(reg->source_on);
+  free(reg->division_skipped);
+  free(reg->divided_now);
+  free(reg->obs_new);
+  free(reg->core_mass_old);
+  free(reg->core_mass);
+  free(reg->shape);
+  free(reg->divisions);
+  free(reg->name);
+  free(reg->cut_normal);
+  *reg = (sp_registry){0};
+}

@@ -1,0 +1,100 @@
+/**
+ * @file run_options.h
+ * @brief The run's options: the scene's settings resolved once, at
+ *        set-up (sp_run_setup builds the run's objects from the scene and
+ *        these); nothing after set-up reads the scene (sp_scene) itself. Each part goes to the module that uses
+ *        it: the solver's options and the model to the glue, the
+ *        controller's parameters to dt_control.h, the division rule to
+ *        division.h, the rest to the step, the events and the monitor.
+ */
+#ifndef SP_RUN_OPTIONS_H
+#define SP_RUN_OPTIONS_H
+
+#include "model/division.h"
+#include "time/dt_control.h"
+#include "mesh/mesh.h"
+#include "io/output.h"
+#include "scene/scene.h"
+#include "softpack_solver.h"
+#include "time/time_scheme.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** How the run steps in time (time.*, solver.predictor). */
+typedef struct {
+  sp_dt_params dt;        /**< the controller's parameters (dt_control.h) */
+  sp_scheme_kind scheme;  /**< time.scheme */
+  int adaptive;           /**< time.control: adaptive */
+  double rtol, atol;      /**< adaptive: the local error tolerances on c */
+  double t_end;           /**< the final time */
+  int max_steps;          /**< accepted steps before the run stops */
+  int predictor_linear;   /**< solver.predictor: linear */
+} sp_run_time;
+
+/** Divisions (division.*) as the events and the cut use them: the one
+ *  division configuration of a run. */
+typedef struct {
+  int divides;                /**< division.criterion is not none */
+  sp_division_params rule;    /**< the criterion (division.h); its reference
+                                   mass and landing tolerance are set with the
+                                   initial cells (sp_run_setup) */
+  int reference_initial;      /**< division.use_initial_mass */
+  int smooth_cut;             /**< division.cut: smooth */
+  int equal_mass_line;        /**< division.line: equal_mass */
+  double observe_threshold;   /**< the observables' threshold on c */
+  double interface_width;     /**< d = sqrt(kappa / alpha): the smooth cut's width */
+} sp_run_division;
+
+/** The explicit terms (source.*, shape.*) and the local supports' shrink rule. */
+typedef struct {
+  double source_rate;      /**< source.rate (0: no source) */
+  double source_off_ratio; /**< source.off_ratio */
+  int source_extrapolated; /**< source.indicator extrapolated: BDF2 steps take
+                                omega_k from c extrapolated to t^{n+1} */
+  double shape_delta[3];   /**< shape.delta1/2/3 (delta3 0 in 2D) */
+  int shape_implicit;      /**< shape.scheme: implicit */
+  int shrink_always;       /**< layout.shrink: always */
+} sp_run_terms;
+
+/** What is written and when (output.*). */
+typedef struct {
+  int every;               /**< fields every this many steps */
+  double interval;         /**< and at multiples of this time (0: off) */
+  int pictures;            /**< PNG pictures */
+  int picture_width;
+  int contacts;            /**< contacts.csv and contacts_<step>.png */
+  double contact_threshold; /**< contacts.h's threshold */
+  int timings;             /**< energy.csv's wall-clock columns */
+  int checkpoint_every;
+  double checkpoint_seconds;
+  int checkpoint_keep;
+  sp_output_units units;   /**< units.csv (output.length_unit, ...) */
+} sp_run_output;
+
+/** Everything a run reads of its scene after set-up. */
+typedef struct {
+  sp_model_params model;
+  sp_solver_options solver;
+  sp_run_time time;
+  sp_run_division division;
+  sp_run_terms terms;
+  sp_run_output output;
+} sp_run_options;
+
+/** @brief The run's options from @p scene (a checked scene: no errors). */
+void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt);
+
+/** @brief The mesh a scene describes. */
+int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out);
+/** @brief Solver options and model parameters from a scene. */
+void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt);
+void sp_model_from_scene(const sp_scene *scene, sp_model_params *model);
+/** @brief The time-step controller's parameters from a scene (dt_control.h). */
+void sp_dt_params_from_scene(const sp_scene *scene, sp_dt_params *params);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,59 @@
+/* The run (stepper.h): set-up, the time loop, the end. */
+#include "run/stepper.h"
+
+#include "base/agree.h"
+#include "public/error.h"
+#include "run/events.h"
+#include "run/monitor.h"
+#include "run/step.h"
+#include "base/wall_clock.h"
+
+/** The time loop: attempts until one is accepted, then its completion, its
+ *  events and its report, until t_end, time.max_steps or a stop. */
+static int run_steps(sp_run *run) {
+  sp_step_begin(run);
+  int rc = sp_monitor_begin(run), stop = 0;
+  while (rc == SP_OK && !stop && !sp_step_run_ends(run)) {
+    sp_step_attempt a;
+    sp_step_events ev;
+    rc = sp_monitor_attempt(run, &a, sp_step_try(run, &a));
+    if (rc == SP_OK && a.verdict == SP_STEP_INTERRUPTED) rc = sp_monitor_interrupted(run, &stop);
+    if (rc != SP_OK || a.verdict != SP_STEP_ACCEPTED) continue;
+    rc = sp_step_complete(run, &a);
+    if (rc == SP_OK) rc = sp_events_after_step(run, a.t, &ev);
+    if (rc == SP_OK) rc = sp_monitor_step(run, &a, &ev, &stop);
+  }
+  sp_monitor_end(run);
+  return rc;
+}
+
+int sp_stepper_run_from(const sp_scene *scene, const sp_run_start *start, const char *out_dir,
+                        MPI_Comm comm, sp_step_callback on_step, void *user,
+                        sp_run_summary *summary) {
+  sp_run_summary sum = {0};
+  const double t0 = sp_wall_clock();
+  sp_run run = {.mon = {.sum = &sum, .out_dir = out_dir, .on_step = on_step,
+                        .on_step_user = user, .t_start = t0, .t_checkpoint = t0}};
+  int rc = sp_run_setup(&run, scene, comm, start);
+  /* Only now, with the input known good on every rank, does anything get
+   * written (the other ranks write pieces into rank 0's directory). */
+  if (rc == SP_OK) rc = sp_monitor_open(&run);
+  if (rc == SP_OK) rc = run_steps(&run);
+  /* A rank that failed alone meets here the other ranks' next agreement
+   * (none without an agreement communicator: its creation failed). */
+  if (run.agree_comm != MPI_COMM_NULL) rc = sp_agree(run.agree_comm, rc);
+  sum.wall_seconds = sp_wall_clock() - t0;
+  if (summary) *summary = sum;
+  sp_run_free(&run);
+  return rc;
+}
+
+int sp_stepper_run_with(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
+                        sp_step_callback on_step, void *user, sp_run_summary *summary) {
+  return sp_stepper_run_from(scene, NULL, out_dir, comm, on_step, user, summary);
+}
+
+int sp_stepper_run(const sp_scene *scene, const char *out_dir, MPI_Comm comm,
+                   sp_run_summary *summary) {
+  return sp_stepper_run_from(scene, NULL, out_dir, comm, NULL, NULL, summary);
+}
