@@ -13,10 +13,10 @@ from ._capi import library_path
 from ._outputs import Fields, read_csv, read_vtu
 from ._run import (RunResult, SceneError, SoftpackError, SolverError, StepInfo,
                    key_of_message, run, scene_text)
-from ._scene import label_initial, write_label_nifti, write_label_png
+from ._scene import label_initial, read_label_image, write_label_nifti, write_label_png
 
 __all__ = ["run", "RunResult", "StepInfo", "SoftpackError", "SceneError", "SolverError",
-           "Fields", "read_vtu", "read_csv", "label_initial", "write_label_png",
+           "Fields", "read_vtu", "read_csv", "label_initial", "read_label_image", "write_label_png",
            "write_label_nifti", "library_path", "key_of_message", "scene_text",
            "library_version", "__version__"]
 

@@ -203,3 +203,75 @@ def materialise_labels(initial, directory):
         write_label_nifti(path, labels, affine)
         initial["label_volume"] = path
     return initial
+
+
+def _unfilter(raw, h, w, bpp):
+    """PNG scanlines un-filtered (filters 0-4) into an h x (w * bpp) array."""
+    stride = w * bpp
+    out = np.zeros((h, stride), dtype=np.uint8)
+    prev = np.zeros(stride, dtype=np.int32)
+    pos = 0
+    for y in range(h):
+        ftype = raw[pos]
+        line = np.frombuffer(raw, dtype=np.uint8, count=stride, offset=pos + 1).astype(np.int32)
+        pos += 1 + stride
+        if ftype == 0:
+            cur = line
+        elif ftype == 2:
+            cur = (line + prev) & 255
+        elif ftype in (1, 3, 4):
+            cur = np.zeros(stride, dtype=np.int32)
+            for i in range(stride):
+                a = cur[i - bpp] if i >= bpp else 0
+                b = prev[i]
+                if ftype == 1:
+                    p = a
+                elif ftype == 3:
+                    p = (a + b) >> 1
+                else:
+                    c = prev[i - bpp] if i >= bpp else 0
+                    pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                    p = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                cur[i] = (line[i] + p) & 255
+        else:
+            raise ValueError(f"PNG: unknown filter {ftype}")
+        out[y] = cur
+        prev = cur
+    return out
+
+
+def read_label_image(path):
+    """The labels of a PNG label image as initial.label_image reads it: an
+    integer array indexed [x, y] (x to the right, y up: the image's bottom
+    row is y = 0), 0 for black (or transparent) pixels, 1..n for the
+    colours in ascending order of 0xRRGGBB (the library's cell order).
+    8-bit RGB or RGBA, not interlaced."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError(f"{path}: not a PNG")
+    pos, idat, hdr = 8, [], None
+    while pos < len(data):
+        n, = struct.unpack(">I", data[pos:pos + 4])
+        kind = data[pos + 4:pos + 8]
+        body = data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+        if kind == b"IHDR":
+            hdr = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat.append(body)
+        elif kind == b"IEND":
+            break
+    w, h, depth, ctype, _, _, interlace = hdr
+    if depth != 8 or ctype not in (2, 6) or interlace:
+        raise ValueError(f"{path}: expected an 8-bit RGB or RGBA PNG, not interlaced")
+    bpp = 3 if ctype == 2 else 4
+    px = _unfilter(zlib.decompress(b"".join(idat)), h, w, bpp).reshape(h, w, bpp).astype(np.uint32)
+    rgb = (px[..., 0] << 16) | (px[..., 1] << 8) | px[..., 2]
+    if bpp == 4:
+        rgb = np.where(px[..., 3] == 0, 0, rgb)
+    colours = np.unique(rgb[rgb != 0])
+    labels = np.zeros(rgb.shape, dtype=np.int32)
+    nz = rgb != 0
+    labels[nz] = np.searchsorted(colours, rgb[nz]) + 1
+    return labels.T[:, ::-1].copy()
