@@ -21,7 +21,7 @@ def read_csv(path):
     """A CSV log as a pandas DataFrame (numpy structured array without
     pandas; empty cells are NaN there)."""
     if pandas is not None:
-        return pandas.read_csv(path)
+        return pandas.read_csv(path, float_precision="round_trip")
     with open(path) as f:
         header = f.readline().strip().split(",")
         rows = [line.rstrip("\n").split(",") for line in f if line.strip()]
