@@ -180,3 +180,22 @@ def test_scene_without_yaml(small, monkeypatch, tmp_path):
     assert text.lstrip().startswith("{")
     r = softpack.run(text, out=None, overrides={"time.max_steps": 1}, name="scene")
     assert r.steps == 1 and (tmp_path / "out" / "scene" / "energy.csv").exists()
+
+
+def test_request_stop_and_no_nested_runs(small, tmp_path):
+    """softpack.request_stop() (sp_run_request_stop: a signal handler's
+    call) stops the run with a checkpoint; a run inside on_step is refused."""
+    nested = []
+
+    def watch(s):
+        if s.step == 1:
+            try:
+                softpack.run(small, out=tmp_path / "nested")
+            except RuntimeError as e:
+                nested.append(str(e))
+        if s.step == 2:
+            softpack.request_stop()
+
+    r = softpack.run(small, out=tmp_path / "o", on_step=watch)
+    assert r.why == "signal" and r.steps <= 3 and r.checkpoints >= 1
+    assert nested and "in progress" in nested[0] and not (tmp_path / "nested").exists()

@@ -12,13 +12,13 @@ public C API, src/public/run.h).  docs/python.md.
 from ._capi import library_path
 from ._outputs import Fields, read_csv, read_vtu
 from ._run import (RunResult, SceneError, SoftpackError, SolverError, StepInfo,
-                   key_of_message, run, scene_text)
+                   key_of_message, request_stop, run, scene_text)
 from ._scene import label_initial, read_label_image, write_label_nifti, write_label_png
 
 __all__ = ["run", "RunResult", "StepInfo", "SoftpackError", "SceneError", "SolverError",
            "Fields", "read_vtu", "read_csv", "label_initial", "read_label_image", "write_label_png",
            "write_label_nifti", "library_path", "key_of_message", "scene_text",
-           "library_version", "__version__"]
+           "library_version", "request_stop", "__version__"]
 
 
 def library_version():

@@ -366,6 +366,10 @@ def run(scene, out=None, overrides=None, on_step=None, comm=None, name=None, res
 
     Raises SceneError (a bad key or value: ``.key``, ``.message``; nothing
     written), SolverError, SoftpackError."""
+    global _running
+    if _running:
+        raise RuntimeError("softpack.run: a run is in progress in this process (called from "
+                           "on_step?): the library runs one scene at a time")
     lib = _capi.library()
     _mpi.ensure_initialised(want_mpi4py=comm is not None)
     handle = _mpi.comm_handle(comm)
@@ -379,19 +383,54 @@ def run(scene, out=None, overrides=None, on_step=None, comm=None, name=None, res
     state = {"exc": None, "t_end": None, "stopped_by": None}
 
     def trampoline(ptr, _user):
+        info = None
         try:
+            if on_step is None:
+                state["t_end"] = ptr.contents.t_end
+                return 0
             info = StepInfo(lib, ptr)
             state["t_end"] = info.t_end
-            stop = on_step(info) if on_step is not None else False
-            info._close()
+            stop = on_step(info)
             if stop:
                 state["stopped_by"] = "callback"
             return 1 if stop else 0
         except BaseException as e:  # noqa: B036 (KeyboardInterrupt too: stop cleanly)
             state["exc"] = e
             return 1
+        finally:
+            if info is not None:
+                info._close()
 
     callback = lib.Callback(trampoline)
+    _running = True
+    try:
+        rc = _run_c(lib, kind, value, name, sets, c_sets, out, restart, handle, callback, summary)
+    finally:
+        _running = False
+    why = _why(summary, state)
+    result = RunResult(summary, out, why, state["t_end"])
+    _check(lib, rc, result)
+    if state["exc"] is not None:
+        e = state["exc"]
+        try:
+            e.softpack_result = result
+        except AttributeError:
+            pass
+        raise e
+    return result
+
+
+_running = False
+
+
+def request_stop():
+    """Ask the run in progress to write a checkpoint at the end of its step
+    and stop there (why = "signal"): sp_run_request_stop, safe from a signal
+    handler or another thread."""
+    _capi.library().lib.sp_run_request_stop()
+
+
+def _run_c(lib, kind, value, name, sets, c_sets, out, restart, handle, callback, summary):
     with tempfile.TemporaryDirectory(prefix="softpack-labels-") as tmp:
         if kind == "dict":
             text = scene_text(value, tmp)
@@ -411,17 +450,7 @@ def run(scene, out=None, overrides=None, on_step=None, comm=None, name=None, res
             rc = lib.lib.sp_run_file_restart(text.encode(), len(sets), c_sets, out.encode(),
                                              ctypes.byref(rs) if rs else None, handle,
                                              callback, None, ctypes.byref(summary))
-    why = _why(summary, state)
-    result = RunResult(summary, out, why, state["t_end"])
-    _check(lib, rc, result)
-    if state["exc"] is not None:
-        e = state["exc"]
-        try:
-            e.softpack_result = result
-        except AttributeError:
-            pass
-        raise e
-    return result
+    return rc
 
 
 def _why(summary, state):
