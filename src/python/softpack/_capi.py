@@ -217,11 +217,14 @@ class Library:
         self.has_fields = hasattr(lib, "sp_step_mesh") and self.api >= (0, 2)
         if self.has_fields:
             lib.sp_step_mesh.restype = ctypes.c_int
+            # int sp_step_mesh(const sp_step_info *, int *dim, int *n_nodes,
+            #     const double **coords, int *n_elements, int *nodes_per_element,
+            #     const int **elements)
             lib.sp_step_mesh.argtypes = [
                 ctypes.POINTER(self.StepInfo), ctypes.POINTER(ctypes.c_int),
-                ctypes.POINTER(ctypes.c_long), ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
-                ctypes.POINTER(ctypes.c_long), ctypes.POINTER(ctypes.c_int),
-                ctypes.POINTER(ctypes.POINTER(ctypes.c_long))]
+                ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
+                ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int),
+                ctypes.POINTER(ctypes.POINTER(ctypes.c_int))]
             lib.sp_step_cell_field.restype = ctypes.c_int
             lib.sp_step_cell_field.argtypes = [ctypes.POINTER(self.StepInfo), ctypes.c_int,
                                                ctypes.POINTER(ctypes.c_double)]

@@ -80,7 +80,8 @@ class StepInfo:
     arrays, one row per cell (cell k of the CSVs is row k - 1):
     ``masses``, ``mass_cores``, ``centres`` (n x dim), ``inertia`` (n x
     dim x dim), ``moments`` (n x dim, descending), ``axes`` (n x dim x dim:
-    axes[k, i] the unit eigenvector of moments[k, i]), ``volumes`` (area in
+    axes[k, i] the unit eigenvector of moments[k, i]), ``long_axes`` (n x
+    dim, axes[:, dim - 1]), ``volumes`` (area in
     2D), ``names`` (a list; "" for an unnamed cell).  With API 0.2,
     ``mesh()`` and ``field(k)`` give the mesh and cell k's c (0-based k)
     during the callback."""
@@ -158,6 +159,12 @@ class StepInfo:
         return np.stack([o["v1"], o["v2"], o["v3"]], axis=1)[:, :self.dim, :self.dim]
 
     @property
+    def long_axes(self):
+        """n x dim: each cell's long axis (the smallest moment's eigenvector;
+        a division's cut is normal to it)."""
+        return self.axes[:, self.dim - 1, :].copy()
+
+    @property
     def inertia(self):
         o = self._obs
         if self._lib.api >= (0, 2):
@@ -186,16 +193,20 @@ class StepInfo:
         """(coords n_nodes x dim, elements n_elements x nodes per element,
         0-based) of the run's mesh (copies)."""
         self._need_live("mesh()")
-        dim, nn, ne, npe = ctypes.c_int(), ctypes.c_long(), ctypes.c_long(), ctypes.c_int()
+        dim, nn, ne, npe, xy, el = self._mesh()
+        coords = np.ctypeslib.as_array(xy, shape=(nn, dim)).copy()
+        elements = np.ctypeslib.as_array(el, shape=(ne, npe)).astype(np.int64)
+        return coords, elements
+
+    def _mesh(self):
+        dim, nn, ne, npe = ctypes.c_int(), ctypes.c_int(), ctypes.c_int(), ctypes.c_int()
         xy = ctypes.POINTER(ctypes.c_double)()
-        el = ctypes.POINTER(ctypes.c_long)()
+        el = ctypes.POINTER(ctypes.c_int)()
         rc = self._lib.lib.sp_step_mesh(self._ptr, ctypes.byref(dim), ctypes.byref(nn),
                                         ctypes.byref(xy), ctypes.byref(ne), ctypes.byref(npe),
                                         ctypes.byref(el))
         _check(self._lib, rc)
-        coords = np.ctypeslib.as_array(xy, shape=(nn.value, dim.value)).copy()
-        elements = np.ctypeslib.as_array(el, shape=(ne.value, npe.value)).astype(np.int64)
-        return coords, elements
+        return dim.value, nn.value, ne.value, npe.value, xy, el
 
     def field(self, cell):
         """Cell @p cell's c on the mesh's nodes (0 off its support);
@@ -203,13 +214,8 @@ class StepInfo:
         self._need_live("field()")
         if not 0 <= cell < self.n_cells:
             raise IndexError(f"cell {cell}: the step has {self.n_cells} cells (0-based)")
-        dim, nn, ne, npe = ctypes.c_int(), ctypes.c_long(), ctypes.c_long(), ctypes.c_int()
-        xy = ctypes.POINTER(ctypes.c_double)()
-        el = ctypes.POINTER(ctypes.c_long)()
-        _check(self._lib, self._lib.lib.sp_step_mesh(
-            self._ptr, ctypes.byref(dim), ctypes.byref(nn), ctypes.byref(xy),
-            ctypes.byref(ne), ctypes.byref(npe), ctypes.byref(el)))
-        c = np.zeros(nn.value)
+        nn = self._mesh()[1]
+        c = np.zeros(nn)
         _check(self._lib, self._lib.lib.sp_step_cell_field(
             self._ptr, cell, c.ctypes.data_as(ctypes.POINTER(ctypes.c_double))))
         return c
