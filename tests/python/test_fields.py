@@ -68,8 +68,17 @@ def test_vtu_fields_2d(small, tmp_path):
 
 
 def test_vtu_fields_3d(source_dir, tmp_path):
+    seen = []
     r = softpack.run(f"{source_dir}/tests/scenes/sphere_3d.yaml", out=tmp_path / "o",
-                     overrides={"time.max_steps": 2, "mesh.nx": 8, "mesh.ny": 8, "mesh.nz": 8})
+                     overrides={"time.max_steps": 2, "mesh.nx": 8, "mesh.ny": 8, "mesh.nz": 8},
+                     on_step=seen.append)
+    s = seen[-1]
+    assert s.dim == 3 and s.centres.shape == (1, 3) and s.moments.shape == (1, 3)
+    assert np.allclose(s.axes[0] @ s.axes[0].T, np.eye(3), atol=1e-9)   # orthonormal
+    assert np.allclose(s.inertia[0] @ s.axes[0].T, s.axes[0].T * s.moments[0], atol=1e-12)
+    assert np.array_equal(s.long_axes[0], s.axes[0, 2])
+    zc = np.asarray(r.cells["zc"], float)[np.asarray(r.cells["step"]) == s.step]
+    assert s.centres[0, 2] == pytest.approx(zc[0], rel=1e-12)
     f = r.fields()
     assert f.dim == 3 and f.elements.shape[1] == 8 and f.coords.shape[1] == 3
     mass, core, centre = gauss_integrals(f, 1)
