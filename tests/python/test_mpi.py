@@ -63,3 +63,14 @@ def test_world_without_comm(tmp_path):
     """comm=None under mpiexec: MPI_COMM_WORLD, the same run."""
     mpirun(2, tmp_path / "world", how="world")
     assert (tmp_path / "world" / "rank1.txt").read_text().endswith("steps 6 size 2\n")
+
+
+def test_comm_self_runs_apart(tmp_path):
+    """comm=MPI.COMM_SELF under mpiexec -n 2: two one-process runs at once,
+    each as the one-process run (a sweep spread over ranks)."""
+    mpirun(2, tmp_path / "self", how="self")
+    mpirun(1, tmp_path / "np1")
+    _, a = table(tmp_path / "np1" / "cells.csv")
+    for r in (0, 1):
+        _, b = table(tmp_path / "self" / f"self{r}" / "cells.csv")
+        assert np.array_equal(a, b, equal_nan=True)
