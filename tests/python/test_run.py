@@ -199,3 +199,18 @@ def test_request_stop_and_no_nested_runs(small, tmp_path):
     r = softpack.run(small, out=tmp_path / "o", on_step=watch)
     assert r.why == "signal" and r.steps <= 3 and r.checkpoints >= 1
     assert nested and "in progress" in nested[0] and not (tmp_path / "nested").exists()
+
+
+def test_names(small, tmp_path):
+    """The cells' names (cells[i].name) in StepInfo.names (API 0.2) and in
+    the fields' cell_name."""
+    small["cells"][0]["name"] = "AB"
+    small["cells"][1]["name"] = "P1"
+    seen = []
+    r = softpack.run(small, out=tmp_path / "o", overrides={"time.max_steps": 2},
+                     on_step=lambda s: seen.append(s.names))
+    assert r.fields().names == ["AB", "P1"]
+    if softpack._capi.library().api >= (0, 2):
+        assert seen == [["AB", "P1"]] * 2
+    else:
+        assert seen == [["", ""]] * 2
