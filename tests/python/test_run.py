@@ -214,3 +214,17 @@ def test_names(small, tmp_path):
         assert seen == [["AB", "P1"]] * 2
     else:
         assert seen == [["", ""]] * 2
+
+
+def test_solver_failure_raises_with_state(small, tmp_path):
+    """A step that fails beyond its retries: SolverError (exit status 1's
+    class), its message, and the result of what was written."""
+    with pytest.raises(softpack.SolverError) as e:
+        softpack.run(small, out=tmp_path / "o",
+                     overrides={"solver.newton_max_its": 1, "time.max_retries": 1,
+                                "time.control": "fixed", "time.dt": 0.01})
+    assert e.value.code == 1 and e.value.kind == "solver"
+    assert "time.max_retries" in e.value.message
+    r = e.value.result
+    assert r.why == "error" and r.steps == 0
+    assert list(column(r.energy, "step")) == [0]

@@ -234,7 +234,8 @@ class RunResult:
     entries as attributes (``steps``, ``failed_attempts``, ``newton_its``,
     ``factorisations``, ``wall_seconds``, ``t_final``, ``divisions``,
     ``n_cells``), ``stopped`` / ``why`` (why it stopped: "t_end",
-    "max_steps", "callback", "exception", "signal"), ``out`` (its
+    "max_steps", "callback", "exception", "signal"; "error" in a
+    SolverError's result), ``out`` (its
     directory) and its outputs read from there on first use: ``energy``,
     ``cells``, ``divisions_table``, ``contacts`` (DataFrames with pandas,
     else numpy structured arrays), ``field_steps`` and ``fields(step)``."""
@@ -413,7 +414,7 @@ def run(scene, out=None, overrides=None, on_step=None, comm=None, name=None, res
         rc = _run_c(lib, kind, value, name, sets, c_sets, out, restart, handle, callback, summary)
     finally:
         _running = False
-    why = _why(summary, state)
+    why = _why(summary, state) if rc == _capi.SP_OK else "error"
     result = RunResult(summary, out, why, state["t_end"])
     _check(lib, rc, result)
     if state["exc"] is not None:
