@@ -154,7 +154,7 @@ def test_key_of_message():
     assert k("scene: time.bogus: unknown key; time has control, scheme") == "time.bogus"
     assert k("--set bogus.key=1: bogus.key: unknown section; the sections are mesh") == "bogus.key"
     assert k("scene: cells[0].radius: expected a number > 0, got -1") == "cells[0].radius"
-    assert k("inputs/x.yaml: mesh.refinements: expected an integer") == "mesh.refinements"
+    assert k("scene.yaml: mesh.refinements: expected an integer") == "mesh.refinements"
 
 
 def test_tables_without_pandas(small, tmp_path, monkeypatch):
