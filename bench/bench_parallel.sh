@@ -18,8 +18,13 @@
 #                from the per-step seconds of energy.csv
 #          r4    as r6 on the default mesh (refined 4 times): a quick check
 #   default: r6 r7 paper16
+# The r cases pin the configuration of docs/parallel.md's table: fixed
+# backward-Euler steps of dt = 2e-6, Newton from the last state with a fresh
+# Jacobian each iteration (so every iteration factors), SuperLU_DIST with
+# iterative refinement; PINNED="" runs them with today's defaults instead
+# (adaptive BDF2, the predictor, modified Newton).
 # Environment: NPS (default "1 2"), SOLVERS (default "superlu superlu_dist
-# mumps"), BIN (default build/softpack).
+# mumps"), BIN (default build/softpack), PINNED (above).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cases=("$@")
@@ -31,6 +36,7 @@ export OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM
 # 2-core machine); override with OMPI_MCA_mpi_yield_when_idle=0.
 export OMPI_MCA_mpi_yield_when_idle=${OMPI_MCA_mpi_yield_when_idle:-1}
 bin=${BIN:-$PWD/build/softpack}
+read -r -a pinned <<< "${PINNED---set time.control=fixed --set time.scheme=be --set solver.predictor=none --set solver.jacobian_reuse=0 --set solver.refine=true}"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
@@ -106,11 +112,13 @@ echo "machine: $(nproc --all) cores, $(lscpu | sed -n 's/^Model name: *//p'), lo
 for c in "${cases[@]}"; do
   case $c in
     r4) table "Ellipse refined 4 times, 3 cells, full supports (4 steps of dt = 2e-6)" r4 "" \
-          inputs/default.yaml --set time.dt=2e-6 --set time.t_end=8e-6 ;;
+          inputs/default.yaml --set time.dt=2e-6 --set time.t_end=8e-6 "${pinned[@]}" ;;
     r6) table "Ellipse refined 6 times, 3 cells, full supports (4 steps of dt = 2e-6)" r6 "" \
-          inputs/default.yaml --set mesh.refinements=6 --set time.dt=2e-6 --set time.t_end=8e-6 ;;
+          inputs/default.yaml --set mesh.refinements=6 --set time.dt=2e-6 --set time.t_end=8e-6 \
+          "${pinned[@]}" ;;
     r7) table "Ellipse refined 7 times, 3 cells, full supports (1 step of dt = 2e-6)" r7 superlu \
-          inputs/default.yaml --set mesh.refinements=7 --set time.dt=2e-6 --set time.t_end=2e-6 ;;
+          inputs/default.yaml --set mesh.refinements=7 --set time.dt=2e-6 --set time.t_end=2e-6 \
+          "${pinned[@]}" ;;
     paper16) # the window's steps from energy.csv's per-step seconds
       WINDOW_T0=0.0124 table "Paper run 1 (16 cells, local supports): the steps from t = 0.0124 to 0.0134 (8 cells)" \
         p16 "" inputs/paper/constant_volume_16.yaml --set time.t_end=0.0134 ;;
