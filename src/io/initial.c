@@ -10,7 +10,7 @@
 
 #include "model/cells.h"
 #include "public/error.h"
-#include "io/output.h"
+#include "io/vtu_read.h"
 
 static int ends_with(const char *s, const char *tail) {
   const size_t n = strlen(s), m = strlen(tail);
