@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Scale (issue 7): one cell to 256 on local supports, inputs/aggregate_256.yaml.
+# Scale: one cell to 256 on local supports, inputs/aggregate_256.yaml.
 # Runs the scene into out/aggregate_256/ (one process, OMP_NUM_THREADS=1;
 # run it with nothing else on the machine: the table is wall time) and
 # prints, from its energy.csv, for every number of cells N the run passed

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The aggregate with the defaults against the published (pinned) run, at
-# the error each buys (issue 28): inputs/aggregate_256.yaml (fixed
+# the error each buys: inputs/aggregate_256.yaml (fixed
 # backward-Euler steps of 2e-4 with algorithm 2's ramp, SuperLU_DIST, the
 # published support rule) and inputs/aggregate_256_defaults.yaml (the same
 # scene with softpack's defaults), both cut at CELLS cells (16 or 64), each

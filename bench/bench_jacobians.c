@@ -11,7 +11,7 @@
  * Both parts start from a scene text set up as a run is (sp_run_setup,
  * run_setup.h: RCB node numbering, the scene's solver keys, layout.support
  * full): n disks on a sunflower spiral, the run's initial profile and
- * seeded background noise. (Before issue 19 the bench built the mesh,
+ * seeded background noise. (The bench once built the mesh,
  * layout and tanh disks by hand, in the mesh's own numbering: figures in
  * docs/jacobians.md measured before then come from that state, which was
  * the same up to the noise's draws and the numbering.)

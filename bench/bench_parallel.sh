@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# MPI runs against one process (issue 6): seconds per Newton iteration and
+# MPI runs against one process: seconds per Newton iteration and
 # per step, split into assembly, factorisation, solves and the rest (the
 # state's all-gather and the reductions of observables and energies, i.e.
 # the communication, plus output and the C core's per-step work), speed-up,

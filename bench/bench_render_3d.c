@@ -1,4 +1,4 @@
-/* Time per 3D picture (issue 29): the 3D run 5's domain (the ellipsoid
+/* Time per 3D picture: the 3D run 5's domain (the ellipsoid
  * 0.5 x 0.25 x 0.25 with a buffer shell of 2 layers, width 0.1) at
  * `refinements` r (default 4: 28672 hexahedra in Omega), 8 spherical cells
  * of radius 0.1 (tanh profile of width 0.02) at the corners of a 2 x 2 x 2

@@ -1,5 +1,4 @@
-/* How a sharp division's split depends on where its line falls (issue 18,
- * report (b)): from the fields a run wrote right after a division (the
+/* How a sharp division's split depends on where its line falls (* report (b)): from the fields a run wrote right after a division (the
  * parent is the sum of its two daughters there, up to the support change's
  * restored mass), the parent's centre and axis as the division saw them,
  * and the child's mass when the line is moved by s along its normal:

@@ -1,4 +1,4 @@
-/* Speed next to error for the stack (issue 2): a three-cell scene on
+/* Speed next to error for the stack: a three-cell scene on
  * n x n rectangles (default n = 64, 128, 256), K steps of dt each from the
  * same initial state. Prints, per mesh: unknowns, Newton iterations per step,
  * seconds per step split into assembly (residual + Jacobian fills),

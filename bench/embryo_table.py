@@ -13,7 +13,7 @@ units the scene names: um, min) and prints, in Markdown:
     unit and as a fraction of the stage's cells, its mass (in the scene's
     unit) and the ratio of the two, its mass fraction, and the
     CShaper atlas's volume and fraction (Cao et al. 2020, as quoted in
-    issue 30);
+    docs/embryo.md);
   - the contacts of those stages: each pair's contact (contacts.csv) in the
     scene's unit and as a fraction of each of the two cells' diffuse
     surfaces, beside the published ones: PUBLISHED holds the contact

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # gmres_cells (GMRES on the cells' diagonal blocks, the 3D default) against
 # MUMPS (the 2D default, the baseline) on 2D scenes, before making it the
-# 2D default too (issue 29): each scene run twice in one go (bench/lib.sh
+# 2D default too: each scene run twice in one go (bench/lib.sh
 # ab_runs: wall time, peak memory, phases, Newton iterations,
 # factorisations, failed attempts, the runs' agreement), then one line per
 # scene with both wall times and their ratio.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Full against local supports on the same scene, in one run (issue 7):
+# Full against local supports on the same scene, in one run:
 # wall time and its phases, unknowns, support changes, and the agreement
 # (energy at every step, cell masses and centres at the end).
 #   bench/local_support.sh [SCENE] [--set k=v ...]   (default: inputs/divide_1_2_4.yaml, no noise)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Full against local supports on the 3D run 5 (inputs/3d/embryo_8.yaml,
-# issue 29): the same run with each layout (bench/lib.sh ab_runs: wall
+# Full against local supports on the 3D run 5 (inputs/3d/embryo_8.yaml):
+# the same run with each layout (bench/lib.sh ab_runs: wall
 # time, peak memory, the largest unknown count, per-step iterations and
 # factorisations, the runs' agreement), then per number of cells the
 # steps, the simulated time they cover, wall seconds per step (and its

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# What agreement with full supports costs (issue 7): runs SCENE with local
+# What agreement with full supports costs: runs SCENE with local
 # supports at each margin (band = margin / 2) up to T_END and compares every
 # run with an earlier full-support run of the same scene (FULL: its output
 # directory, e.g. OUT=dir bench/local_support.sh SCENE keeps dir/full).

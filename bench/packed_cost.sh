@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Cost per step and per cell at a fixed number of cells (issue 7, "Scale"):
+# Cost per step and per cell at a fixed number of cells ("Scale"):
 # N just-born cells (radius 0.065, the aggregate's birth size) on a
 # hexagonal lattice of spacing 0.15, the N sites nearest the centre of the
 # 2 x 1 ellipse of inputs/aggregate_256.yaml (its mesh, model, supports and

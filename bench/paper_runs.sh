@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Reruns the paper's runs 1, 2 and 5 (issue 3) and prints, per run, the
+# Reruns the paper's runs 1, 2 and 5 and prints, per run, the
 # table of docs/paper-runs.md; copies the pictures at each stage (the last
 # picture with N cells, for every N reached) and the energy curve to
 # docs/img/paper/<run>/.
 #   bench/paper_runs.sh [--reuse] [run ...]
-#   runs: constant_volume_16 growth_12 embryo_8 growth_shape_12 (issue 4's run 4;
+#   runs: constant_volume_16 growth_12 embryo_8 growth_shape_12 (the paper's run 4;
 #   with run 2 it prints the comparison of the two), and on request
 #   growth_shape_strong_12 and growth_shape_implicit_12 (run 4 with stronger
 #   penalties, the latter with the implicit term; added to the comparison),
@@ -62,7 +62,7 @@ for run in "${runs[@]}"; do
   echo "   pictures: $(ls "$img" | tr '\n' ' ')"
 done
 
-# Run 4 against run 2 (issue 4): the energy, the spikes at the divisions
+# Run 4 against run 2: the energy, the spikes at the divisions
 # and the packing at the end. Spike of a division at step S: height
 # (peak - e0) / e0 with e0 the energy of step S-1 and the peak the largest
 # energy before the next division; width: time from step S-1 until the

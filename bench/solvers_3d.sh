@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Where the direct solvers stop in 3D (issue 29): the paper's run 5 in 3D
+# Where the direct solvers stop in 3D: the paper's run 5 in 3D
 # (inputs/3d/embryo_8.yaml) cut to STEPS steps, for each case r:cells
 # (mesh.refinements r; cells 1: the scene's zygote, 8: eight spheres of
 # radius 0.09 at (+-0.11, +-0.095, +-0.095), the scene's cells replaced

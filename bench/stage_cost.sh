@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Cost of one stage of a run with full and with local supports (issue 7):
+# Cost of one stage of a run with full and with local supports:
 # the cells of RUN_DIR's last (or given) step, as disks of their masses at
 # their centres, on SCENE's mesh and model, without division or source, for
 # STEPS steps of dt: seconds per step and per Newton iteration, its phases,

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A support rule against another (issue 29): each scene run with
+# A support rule against another: each scene run with
 # --set KEY=BASE (the baseline) and --set KEY=NEW, in one go
 # (bench/lib.sh ab_runs: wall time, peak memory, phases, the runs'
 # agreement), then one line per scene and value: the largest energy rise

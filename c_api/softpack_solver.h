@@ -133,13 +133,13 @@ typedef struct {
   const int *slot_pair;      /**< nodes_per_elem n_slots */
 } sp_layout_view;
 
-/** Model parameters (MODEL.md). */
+/** Model parameters (docs/model.md). */
 typedef struct {
   double alpha, kappa, lambda, lambda_b, mobility;
 } sp_model_params;
 
 /**
- * Shape-penalty data of one cell (MODEL.md, shape penalty): the term adds
+ * Shape-penalty data of one cell (docs/model.md, shape penalty): the term adds
  * -sum_i coef_i * (v_i . Ibar(X) v_i) to mu_k, Ibar about the centre (xc,
  * yc[, zc]), i over the mesh's dim principal moments (2 in 2D, 3 in 3D;
  * Ibar = |Xb|^2 Id - Xb Xb^T, src/model/shape.h). Entries beyond dim are unused.
@@ -204,7 +204,7 @@ typedef struct {
   char reason[160];     /**< why it failed (empty when converged) */
 } sp_step_report;
 
-/** Energy parts (MODEL.md); shape is added by the C core. */
+/** Energy parts (docs/model.md); shape is added by the C core. */
 typedef struct {
   double bulk, gradient, repulsion, buffer;
 } sp_energy_parts;
@@ -259,7 +259,7 @@ int sp_solver_carry_mark(sp_solver s);
 /**
  * @brief Report the marked carry point again (a step given up half-way, so
  *        that a checkpoint written now equals the one written before the
- *        step: issue 30's stop during a long step). The factorisation itself
+ *        step: a stop during a long step). The factorisation itself
  *        is the given-up attempt's: the next step begins with a new one.
  */
 int sp_solver_carry_rewind(sp_solver s);

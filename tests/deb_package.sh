@@ -6,7 +6,8 @@
 # Checks: the control fields (name, version, Depends naming openmpi-bin and
 # every runtime package CMake lists), the files under /usr (the headers
 # exactly the public ones, as tests/install_tree.sh checks of the tree),
-# and the unpacked bin/softpack running with the libsoftpack beside it.
+# and the unpacked bin/softpack running with the libsoftpack beside it, and
+# the unpacked Python package importing with it (Depends: python3, python3-numpy).
 # Exit status 77 (skipped) without dpkg-deb.
 set -euo pipefail
 build=$1 cpack=$2 version=$3 soversion=$4 lib=$5
@@ -26,7 +27,7 @@ dpkg-deb -I "$deb"
 [ "$(dpkg-deb -f "$deb" Package)" = softpack ] || fail "package name"
 [ "$(dpkg-deb -f "$deb" Version)" = "$version" ] || fail "version $(dpkg-deb -f "$deb" Version)"
 depends=$(dpkg-deb -f "$deb" Depends)
-for package in openmpi-bin "$@"; do
+for package in openmpi-bin python3 python3-numpy "$@"; do
   grep -Eq "(^|, )$package( |,|$)" <<< "$depends" || fail "Depends lacks $package: $depends"
 done
 
@@ -34,7 +35,8 @@ dpkg-deb -c "$deb" | awk '{print $6}' > "$tmp/files"
 for f in ./usr/bin/softpack "./usr/$lib/libsoftpack.so.$soversion" ./usr/include/softpack/run.h \
          "./usr/$lib/cmake/softpack/softpackConfig.cmake" "./usr/$lib/pkgconfig/softpack.pc" \
          ./usr/share/softpack/inputs/default.yaml ./usr/share/softpack/inputs/paper/embryo_8.yaml \
-         ./usr/share/softpack/doc/README.md; do
+         ./usr/share/softpack/doc/README.md ./usr/lib/python3/dist-packages/softpack/__init__.py \
+         ./usr/lib/python3/dist-packages/softpack/_install.py; do
   grep -qxF "$f" "$tmp/files" || fail "the package has no $f"
 done
 public="./usr/include/softpack/cell_obs.h
@@ -53,4 +55,14 @@ dpkg-deb -x "$deb" "$tmp/root"
 out=$(OMP_NUM_THREADS=1 "$tmp/root/usr/bin/softpack" --version)
 [[ $out == "softpack $version "* ]] || fail "the unpacked softpack --version says '$out'"
 echo "unpacked: $out"
+# the Python package of the unpacked tree loads the libsoftpack beside it
+py=${SOFTPACK_PYTHON:-/usr/bin/python3}
+if "$py" -c "import numpy" 2> /dev/null; then
+  pyout=$(cd "$tmp" && env -u SOFTPACK_LIBRARY PYTHONDONTWRITEBYTECODE=1 \
+    PYTHONPATH="$tmp/root/usr/lib/python3/dist-packages" "$py" -c \
+    "import softpack; print(softpack.__version__, softpack.library_path())") ||
+    fail "import softpack from the unpacked package: $pyout"
+  [[ $pyout == "$version $tmp/root/usr/$lib/"* ]] || fail "the unpacked package's softpack: $pyout"
+  echo "unpacked python: $pyout"
+fi
 echo "deb_package: all checks passed"

@@ -17,6 +17,7 @@
 # 5. The prefix moved elsewhere: bin/softpack run of the installed default
 #    scene (two short steps) from a directory outside the source tree, with
 #    libsoftpack found in the moved prefix.
+# 6. The Python package in the moved prefix (see 6. below).
 set -euo pipefail
 build=$1 source=$2 cmake=$3 pkg_config=$4 cc=$5 lib=$6
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/softpack_install.XXXXXX")
@@ -137,4 +138,25 @@ loaded=$(ldd "$tmp/moved/bin/softpack" | awk '/libsoftpack/ {print $3}')
 steps=$(($(wc -l < out/default/energy.csv) - 1))
 [ "$steps" -ge 2 ] || fail "energy.csv has $steps rows"
 [ -e out/default/fields.pvd ] || fail "no fields.pvd"
+# 6. The Python package in the moved tree (docs/python.md): imported with
+#    PYTHONPATH=PREFIX/lib/python3/dist-packages, it loads the moved
+#    prefix's libsoftpack (whatever SOFTPACK_LIBRARY says) and runs the
+#    installed default scene for two steps. Skipped without numpy.
+py=${SOFTPACK_PYTHON:-/usr/bin/python3}
+if "$py" -c "import numpy" 2> /dev/null; then
+  pyout=$(env -u SOFTPACK_LIBRARY PYTHONDONTWRITEBYTECODE=1 \
+    PYTHONPATH="$tmp/moved/lib/python3/dist-packages" "$py" -c "
+import softpack, sys
+print(softpack.__version__, softpack.library_path())
+r = softpack.run(sys.argv[1], out='py_out', overrides={'time.dt': 1e-6, 'time.t_end': 1e-5,
+                 'time.max_steps': 2, 'output.pictures': False})
+print(r.steps, len(r.energy))" "$tmp/moved/share/softpack/inputs/default.yaml") ||
+    fail "the installed Python package: $pyout"
+  echo "python: $pyout"
+  [ "$(realpath "$(sed -n '1s/^[^ ]* //p' <<< "$pyout")")" = "$(realpath "$tmp/moved/$lib/$soname")" ] ||
+    fail "the installed Python package loads another libsoftpack: $pyout"
+  [ "$(sed -n 2p <<< "$pyout")" = "2 3" ] || fail "the installed Python package's run: $pyout"
+else
+  echo "python: $py has no numpy: the Python package not checked"
+fi
 echo "install_tree: all checks passed"

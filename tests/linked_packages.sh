@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Trilinos 16 deprecated and 17 removes Epetra, EpetraExt, NOX's Epetra
-# adapters, AztecOO, Ifpack, ML and Amesos (v1) (issue 31). The built
+# adapters, AztecOO, Ifpack, ML and Amesos (v1). The built
 # library must not directly need (ELF DT_NEEDED, readelf -d) any of them:
 # the assembly is on Tpetra, NOX runs through Thyra on Tpetra vectors
 # (cxx_glue/newton.cpp), the linear solvers through their own libraries,

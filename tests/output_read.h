@@ -118,7 +118,7 @@ static inline const char *at_str(const csv_table *t, int i, const char *name) {
   return t->str[(size_t)i * t->n_cols + csv_col(t, name)];
 }
 
-/* A row of a named scene's divisions.csv (docs/output.md): the cut's
+/* A row of a named scene's divisions.csv (README.md, "Outputs"): the cut's
  * normal from long_x, long_y, long_z in 3D, (cos, sin) of axis_angle in
  * 2D (angle: axis_angle, NAN in 3D). */
 typedef struct {

@@ -2,7 +2,7 @@
  * 8-cell stage by its lineage table, s = 0), through `softpack run`,
  * about 15 s of CPU:
  * - the table's fractions are the CShaper atlas's volume ratios (Cao et
- *   al. 2020, as quoted in issue 30) to 5e-7 (the scene gives 6 digits);
+ *   al. 2020) to 5e-7 (the scene gives 6 digits);
  * - divisions.csv has exactly the table's 7 divisions, no more (s = 0,
  *   no division: rules), in the embryo's order: AB before P1, ABa and ABp
  *   before EMS, P2 last; each first daughter's share of its parent's mass

@@ -1,4 +1,4 @@
-/* The 3x3 inertia tensor of a cell on a 3D mesh (src/model/cells.c, issue 29
+/* The 3x3 inertia tensor of a cell on a 3D mesh (src/model/cells.c
  * phase 2; docs/3d.md):
  *  - the eigensolver (sp_cells_principal): a tensor R diag(3, 2, 1) R^T
  *    gives back 3, 2, 1 (1e-14 relative) and the rotated axes (1e-14);

@@ -7,7 +7,7 @@
 //   analysis (symbolic_count stays 1) and solves the new system;
 // - a singular matrix (one row of zeros): MUMPS' and KLU's factor()
 //   returns false with a reason naming it, and the process goes on
-//   (through Amesos, MUMPS ended the process with exit(); issue 31).
+//   (through Amesos, MUMPS ended the process with exit()).
 // Backends: MUMPS, SuperLU_DIST, and serial KLU (gathered on rank 0 on
 // several ranks); the others agree with MUMPS to 1e-13.
 // Rows are split in contiguous blocks by rank, as CsrRows wants.

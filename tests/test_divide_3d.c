@@ -1,4 +1,4 @@
-/* Divisions through the run in 3D (issue 29 phase 2), as `softpack run`
+/* Divisions through the run in 3D, as `softpack run`
  * makes them (scene, box of hexahedra, full supports, MUMPS):
  *  - tests/scenes/divide_3d.yaml: one ellipsoidal cell (semi-axes 0.17,
  *    0.11, 0.11, long along x) at constant volume (s = 0, backward Euler,

@@ -1,4 +1,4 @@
-/* Division on a 3D mesh (src/model/division.c, issue 29 phase 2; docs/3d.md):
+/* Division on a 3D mesh (src/model/division.c; docs/3d.md):
  * the cut is the plane through the centre of mass normal to the long axis
  * (the eigenvector of the smallest principal moment, sp_division_plane).
  *  - an ellipsoid 0.14 x 0.08 x 0.07 long along x, and the same turned to a

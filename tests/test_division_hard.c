@@ -1,4 +1,4 @@
-/* Hard cases of division (issue 3):
+/* Hard cases of division:
  * - eight cells dividing in the same step: 8 -> 16 cells, eight rows of
  *   divisions.csv with the same step, each split conserving its parent's
  *   mass, total mass conserved; one cell is pressed against the buffer ring;

@@ -1,4 +1,4 @@
-/* initial.from in 3D (issue 29): a new run's initial fields from a short
+/* initial.from in 3D: a new run's initial fields from a short
  * 3D run's .vtu and from its checkpoint (.h5), on the same mesh of
  * hexahedra; a mesh that is not the file's is bad input.
  *  - a run of two spheres in a box of 8 x 8 x 8 hexahedra writes

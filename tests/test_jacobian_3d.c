@@ -1,4 +1,4 @@
-/* The element Jacobians on hexahedra (3D, issue 29), as tight as the 2D
+/* The element Jacobians on hexahedra (3D), as tight as the 2D
  * tests (test_jacobian.c, test_jacobian_hand.c) assert them:
  *  - on random states with 1, 2 and 3 cells (SFad 16 and 32 unknowns, and
  *    DFad at 48), on a box of hexahedra whose nodes are moved at random

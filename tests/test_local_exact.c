@@ -1,5 +1,5 @@
 /* Local supports reproduce full supports where the margin holds the whole
- * diffuse interface (issue 7). Two cells face each other across a 2 x
+ * diffuse interface. Two cells face each other across a 2 x
  * 0.05 strip: c_1 fills x < 1/2, c_2 x > 3/2, with flat interfaces. A
  * flat interface keeps no far field (its chemical potential is 0, and so
  * is c = mu / 2 alpha away from it), so its profile decays as

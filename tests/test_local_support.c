@@ -1,4 +1,4 @@
-/* Local supports (issue 7):
+/* Local supports:
  * - local and full supports agree on a short scene (10 steps): energy to
  *   1e-5 relative with a margin of 40 interface widths (measured 7e-7),
  *   1e-3 with 20 widths (measured 5e-4): the cut far field of each field

@@ -1,4 +1,4 @@
-/* Local supports in 3D (issue 29), through `softpack run`'s stepper on
+/* Local supports in 3D, through `softpack run`'s stepper on
  * tests/scenes/local_divide_3d.yaml (a box of hexahedra, one ellipsoidal
  * cell dividing 1 -> 2 -> 4 by age, s = 0, backward Euler, fixed dt, no
  * shape term, supports of whole hexahedra with the default margin 8 d):

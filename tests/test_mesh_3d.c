@@ -1,4 +1,4 @@
-/* The ellipsoid mesh (sp_mesh_ellipsoid, the cubed ball: issue 29), each
+/* The ellipsoid mesh (sp_mesh_ellipsoid, the cubed ball), each
  * test_* function one behaviour:
  *  - node and element counts equal the formulas (n = 2^r, L buffer shells)
  *    V = (n+1)^3 + (n+L)(6n^2+2), E = n^3 + 6n^2(n+L), and

@@ -1,4 +1,4 @@
-/* Relaxation in 3D (issue 29, phase 1), through the run as `softpack run`
+/* Relaxation in 3D (phase 1), through the run as `softpack run`
  * makes it (scene, box of hexahedra, spheres, RCB, MUMPS, backward Euler,
  * s = 0, no division, no shape term):
  *  - tests/scenes/sphere_3d.yaml (one sphere), two_spheres_3d.yaml (two

@@ -1,4 +1,4 @@
-/* Frame indifference of the 3D model (issue 29): a scene and the same scene
+/* Frame indifference of the 3D model: a scene and the same scene
  * turned by the rotation P (x, y, z) -> (y, z, x), or by the quarter turn
  * about z Q (x, y, z) -> (y, -x, z), give the same run, turned.
  *

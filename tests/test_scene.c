@@ -124,7 +124,7 @@ static void test_defaults(void) {
     CHECK(s->cells[1].profile == SP_PROFILE_SHARP, "profile %d",
           s->cells[1].profile);
   }
-  /* d = sqrt(kappa / (2 alpha)) = sqrt(1e-3 / 8), about 0.011 (MODEL.md) */
+  /* d = sqrt(kappa / (2 alpha)) = sqrt(1e-3 / 8), about 0.011 (docs/model.md) */
   CHECK_NEAR(sp_scene_interface_width(s), sqrt(1e-3 / 8.0), 1e-15);
 
   sp_scene_destroy(&s);

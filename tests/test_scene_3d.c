@@ -1,4 +1,4 @@
-/* Scenes on a 3D mesh (mesh.type box, ellipsoid; issue 29):
+/* Scenes on a 3D mesh (mesh.type box, ellipsoid):
  *  - a box scene with spheres loads: dimension 3, the cells' z, the box's
  *    z0, z1, nz; so does an ellipsoid scene (semi_z);
  *  - an ellipsoid without semi_z, with semi_z <= 0 or refinements > 7, a

@@ -1,4 +1,4 @@
-/* The shape penalty (src/model/shape.c, MODEL.md "Shape penalty"):
+/* The shape penalty (src/model/shape.c, docs/model.md "Shape penalty"):
  * - inertia tensors of a disk, an ellipse and a rotated ellipse with a thin
  *   tanh profile against the profile's exact integrals, on three meshes
  *   (second order in h), and the area inside c = 1/2 against pi a b;

@@ -1,4 +1,4 @@
-/* The element-slot table and the per-cell lists (issue 20, "costs that
+/* The element-slot table and the per-cell lists ("costs that
  * follow the cells"):
  * - sp_layout_slots gives, for every element, exactly the cells whose four
  *   nodes all carry them, by increasing cell, with their pairs (checked

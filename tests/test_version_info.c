@@ -55,7 +55,7 @@ int main(int argc, char **argv) {
     CHECK(strstr(value, "not in this build") == NULL, "%s: %s", key, value);
   }
   /* klu2 is served by Amesos2, klu by SuiteSparse's own KLU and mumps by
-   * MUMPS' own C interface (no Amesos v1: issue 31): not one library twice */
+   * MUMPS' own C interface (not through Amesos2): not one library twice */
   const char *klu2 = NULL, *klu = NULL;
   CHECK(sp_solver_linear_backend(SP_LINEAR_KLU2, &klu2) == 1 && klu2 &&
             strstr(klu2, "Amesos2") != NULL,
@@ -67,7 +67,7 @@ int main(int argc, char **argv) {
   CHECK(sp_solver_linear_backend(SP_LINEAR_MUMPS, &mumps) == 1 && mumps &&
             strstr(mumps, "MUMPS") != NULL && strstr(mumps, "Amesos") == NULL,
         "mumps is served by '%s', want MUMPS' own interface", mumps ? mumps : "(none)");
-  /* gmres_ilu: Belos and Ifpack2 (no AztecOO, Ifpack: issue 31) */
+  /* gmres_ilu: Belos and Ifpack2 (only those) */
   const char *gmres = NULL;
   CHECK(sp_solver_linear_backend(SP_LINEAR_GMRES_ILU, &gmres) == 1 && gmres &&
             strstr(gmres, "Belos") != NULL && strstr(gmres, "Ifpack2") != NULL &&

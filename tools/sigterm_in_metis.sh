@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The two-process SIGTERM crash of issue 27, made deterministic: a SIGTERM
+# The two-process SIGTERM crash inside METIS, made deterministic: a SIGTERM
 # that reaches a process while METIS orders a matrix (METIS_NodeND, called
 # by SuperLU_DIST's and MUMPS's orderings at every new sparsity pattern:
 # the first step, each division, each support change).

@@ -16,10 +16,16 @@ cd "$(dirname "$0")/.."
 
 # libptscotch-dev/libscotch-dev: Debian's Zoltan CMake config names their
 # .so files although nothing pulls them in (docs/building.md).
+# python3-*: the Python package (src/python/softpack, docs/python.md) needs
+# numpy only; pytest runs its tests (ctest -L python); pandas, yaml, mpi4py,
+# matplotlib, nibabel are used where present (and by its tests and
+# examples/); nbformat/nbconvert/ipykernel execute the example notebook.
 PACKAGES=(cmake make g++ pkg-config
   trilinos-all-dev trilinos-dev libsuperlu-dev libsuperlu-dist-dev libmumps-dev libsuitesparse-dev
   libopenmpi-dev openmpi-bin libptscotch-dev libscotch-dev libopenblas-dev
-  libcyaml-dev libcairo2-dev libhdf5-openmpi-dev libnifti2-dev)
+  libcyaml-dev libcairo2-dev libhdf5-openmpi-dev libnifti2-dev
+  python3-numpy python3-pytest python3-pandas python3-yaml python3-mpi4py python3-matplotlib
+  python3-nibabel python3-nbformat python3-nbconvert python3-ipykernel)
 
 # install_missing [EXTRA_PACKAGE...]: PACKAGES and the extras a command needs
 install_missing() {

@@ -1,4 +1,4 @@
-// The pointwise physics of MODEL.md, written once and templated on the
+// The pointwise physics of docs/model.md, written once and templated on the
 // scalar type: double for residuals and energies, Sacado Fad types for the
 // AD Jacobian. The hand Jacobian uses the explicit derivatives below.
 #ifndef SP_PHYSICS_HPP
@@ -44,7 +44,7 @@ template <class S> S buffer_d1(const sp_model_params &m, const S &c) {
 }
 inline double buffer_d2(const sp_model_params &m) { return 2.0 * m.lambda_b; }
 
-// Ihat = v . Ibar(Xb) v with Ibar(Xb) = |Xb|^2 Id - Xb Xb^T (MODEL.md; in 2D
+// Ihat = v . Ibar(Xb) v with Ibar(Xb) = |Xb|^2 Id - Xb Xb^T (docs/model.md; in 2D
 // [[Xb2^2, -Xb1 Xb2], [-Xb1 Xb2, Xb1^2]]): the derivative of the principal
 // moment of eigenvector v in c. In 3D written as |v x Xb|^2 (the same for a
 // unit v: no cancellation where Xb is along v, never negative); the 2D

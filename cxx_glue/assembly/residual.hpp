@@ -1,4 +1,4 @@
-// The element residual of the mixed backward-Euler weak form (MODEL.md,
+// The element residual of the mixed backward-Euler weak form (docs/model.md,
 // "Dynamics"), templated on the scalar type so one code gives residuals
 // (double) and AD Jacobians (Sacado Fad).
 //

@@ -57,7 +57,9 @@ std::unique_ptr<LinearSolver> make_linear_solver(MPI_Comm comm, const sp_solver_
   if (size == 1 || b->ranks == SP_LINEAR_PARALLEL) return b->make(comm, options);
   if (b->ranks == SP_LINEAR_GATHERED)
     return make_gathered(comm, rank == 0 ? b->make(comm, options) : nullptr);
-  // Every rank refuses here, at set-up, before anything is written.
+  // Every rank refuses here, at set-up, before anything is written: the
+  // solver's own factory first, which may say why, else with the list.
+  b->make(comm, options);
   throw input_error(std::string("solver.linear: ") + b->name +
                     " runs on one MPI process only (this run has " + std::to_string(size) +
                     "; docs/parallel.md); with several processes use one of " +

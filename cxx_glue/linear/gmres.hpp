@@ -1,5 +1,5 @@
 // Belos' pseudo-block GMRES on a TpetraRows matrix with a right
-// preconditioner, as AztecOO's GMRES did (issue 31): x0 = 0, the test
+// preconditioner, as AztecOO's GMRES did: x0 = 0, the test
 // |b - A x| <= tolerance |b| on the recursive and then the true residual,
 // classical Gram-Schmidt with a second pass (ICGS), the restart and the
 // iteration limit of KrylovOptions. Shared by gmres_ilu (linear_gmres_ilu.cpp)

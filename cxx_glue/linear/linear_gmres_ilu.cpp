@@ -5,9 +5,8 @@
 // (docs/building.md). factor() computes the ILU of A; solve() runs GMRES on
 // the A of the last factor() to a residual of tolerance x |b|.
 //
-// The same method as the AztecOO + Ifpack solver this replaces (issue 31:
-// Trilinos 17 removes both): the preconditioner on the right (A M^-1 y = b,
-// x = M^-1 y, as AztecOO's GMRES), the start x0 = 0, the test
+// The method: the preconditioner on the right (A M^-1 y = b,
+// x = M^-1 y), the start x0 = 0, the test
 // |b - A x| <= tolerance |b| (AZ_conv = AZ_rhs) on the recursive residual
 // and then, as AztecOO does, on the true one; classical Gram-Schmidt with
 // a second pass (AztecOO's AZ_classic, Belos' ICGS); the restart and the

@@ -1,5 +1,5 @@
 // KLU through SuiteSparse's own library (Debian's libsuitesparse-dev), not
-// Amesos (v1), which Trilinos 17 removes (issue 31). Serial: one rank
+// Amesos (v1), which Trilinos 17 removes. Serial: one rank
 // holds all rows (under MPI, make_gathered runs it on rank 0).
 //
 // As for serial SuperLU, the CSR arrays of A are the CSC arrays of A^T:

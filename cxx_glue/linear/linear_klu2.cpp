@@ -1,6 +1,6 @@
 // KLU2 through Amesos2 on a Tpetra copy of the CSR rows (tpetra_rows.hpp):
 // solver.linear: klu2. One process only: Debian 13.2's Amesos2 returns wrong
-// solutions with several ranks (STACK.md), so Solver refuses klu2 there and
+// solutions with several ranks (docs/building.md), so Solver refuses klu2 there and
 // this backend checks it again. Amesos2's symbolic factorisation (KLU's
 // ordering) is done once per pattern, each factor() overwrites the values
 // in place and refactors numerically.
@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "base/errors.hpp"
 #include "linear/linear.hpp"
 #include "linear/tpetra_rows.hpp"
 
@@ -113,6 +114,14 @@ std::unique_ptr<LinearSolver> make_amesos2_klu2(MPI_Comm comm) {
 }
 
 std::unique_ptr<LinearSolver> make_linear_klu2(MPI_Comm comm, const sp_solver_options &) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  if (size > 1)
+    throw input_error("solver.linear: klu2 runs on one MPI process only (this run has " +
+                      std::to_string(size) +
+                      "): Debian's Amesos2 KLU2 (Trilinos 13.2) is miscompiled by gcc 12 and "
+                      "gives wrong answers on 2 or more processes (docs/building.md); use "
+                      "superlu_dist, mumps or klu with several processes");
   return make_amesos2_klu2(comm);
 }
 

@@ -1,6 +1,6 @@
 // MUMPS through its own C interface (dmumps_c, Debian's libmumps-dev), on
-// the CSR rows as they are distributed: no Amesos, no Epetra (issue 31:
-// Amesos v1 goes with Trilinos 17).
+// the CSR rows as they are distributed, with no Trilinos solver package
+// in between.
 //
 // One process: the centralised assembled input (ICNTL(18) = 0), the rows'
 // own arrays as the values. Several: the distributed assembled input

@@ -21,7 +21,7 @@ static int check_pair_count(int64_t count, int n_nodes, int n_cells) {
   SP_CHECK(count <= SP_LAYOUT_MAX_PAIRS, SP_ERR_MEMORY,
            "layout: %lld (cell, node) pairs (%d cells on %d nodes), more than %d: "
            "their 2 x pairs unknowns would overflow the solver's 32-bit indices "
-           "(Epetra's global ids)",
+           "(the solver's global ids are 32-bit)",
            (long long)count, n_cells, n_nodes, SP_LAYOUT_MAX_PAIRS);
   return SP_OK;
 }

@@ -21,12 +21,12 @@ extern "C" {
 #endif
 
 /** The most (cell, node) pairs a layout may have: pairs, their 2 x pairs
- *  unknowns (state[2p + 1]) and the solver's global ids (Epetra's are
+ *  unknowns (state[2p + 1]) and the solver's global ids (the glue's are
  *  32-bit ints) are all ints. */
 #define SP_LAYOUT_MAX_PAIRS (INT_MAX / 2)
 
 /** The most nonzeros the solver's matrix may have: its row offsets are
- *  ints in Epetra (per rank), serial SuperLU and SuperLU_DIST (global
+ *  ints in the glue's CSR rows (per rank), serial SuperLU and SuperLU_DIST (global
  *  counts), and the serial backends gather every row on one process. */
 #define SP_LAYOUT_MAX_NONZEROS ((long long)INT_MAX)
 

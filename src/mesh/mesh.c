@@ -1,8 +1,8 @@
 /**
  * @file mesh.c
  * @brief Rectangle meshes, the paper's five-patch disk mapped to an
- *        ellipse (MODEL.md, "Mesh of the paper's runs" and "Buffer zone"),
- *        and in 3D (issue 29) hexahedral boxes and its twin, the cubed ball
+ *        ellipse (docs/model.md, "Mesh of the paper's runs" and "Buffer zone"),
+ *        and in 3D hexahedral boxes and its twin, the cubed ball
  *        mapped to an ellipsoid (docs/3d.md).
  *
  * The five-patch disk of refinement r has n = 2^r elements along every patch

@@ -1,7 +1,7 @@
 /**
  * @file cells.h
- * @brief The cell registry and the geometric observables of each cell
- *        computed from its field c_k alone (mesh integrals, 2x2 or 2x2x2 Gauss).
+ * @brief The geometric observables of each cell computed from its field c_k
+ *        alone (mesh integrals, 2x2 or 2x2x2 Gauss; the registry: registry.h).
  */
 #ifndef SP_CELLS_H
 #define SP_CELLS_H
@@ -72,7 +72,7 @@ void sp_cells_principal(int dim, const double tensor[3][3], double moments[3], d
 double sp_cells_obs_angle(const sp_cell_obs *o, int dim);
 
 /**
- * @brief The initial fields of a scene (MODEL.md): cell k's profile p_k
+ * @brief The initial fields of a scene (docs/model.md): cell k's profile p_k
  *        (tanh with the equilibrium width d, or sharp) plus the seeded
  *        background, c_k = p_k + (1 - p_k) (b + a U(-1,1)), and mu_k = 0.
  * @param[out] state 2 n_pairs values in layout order

@@ -1,6 +1,6 @@
 /**
  * @file contacts.h
- * @brief Contacts measured from the fields (issue 30, capability 2;
+ * @brief Contacts measured from the fields (capability 2;
  *        docs/model.md, "Contacts"): each cell's diffuse surface
  *        S_k = int |grad c_k| dV, each pair's contact
  *        A_kl = int min(|grad c_k|, |grad c_l|) dV (the interface density

@@ -1,6 +1,6 @@
 /**
  * @file division.h
- * @brief Cell division (MODEL.md "Division", paper section 2.3, algorithms 1
+ * @brief Cell division (docs/model.md "Division", paper section 2.3, algorithms 1
  *        and 2): the per-cell birth record, the crossing-safe criteria (age,
  *        mass), the division axis, the split of one field into two, the
  *        paper's time-step sequence after a division and N_max.
@@ -68,7 +68,7 @@ typedef struct {
                               (NaN: no entry) */
 } sp_division_record;
 
-/** Division criterion (MODEL.md "Division"), chosen per scene. */
+/** Division criterion (docs/model.md "Division"), chosen per scene. */
 typedef enum {
   SP_DIVIDE_AGE = 0, /**< divide when t - birth_time reaches T_div */
   SP_DIVIDE_MASS = 1 /**< divide when the mass reaches ratio x a reference */
@@ -84,7 +84,7 @@ typedef struct {
                               mass_ratio x this (the authors' code: "m > 2
                               m(initial cell)", pass the initial cell's birth
                               mass); 0: at mass_ratio x its own birth mass
-                              (MODEL.md) */
+                              (docs/model.md) */
   double tolerance;      /**< relative: due once the watched quantity (age or
                               mass) is >= (1 - tolerance) x its threshold; 0
                               means exactly at the threshold. A step shortened
@@ -311,7 +311,7 @@ void sp_division_record_births(double t, const sp_cell_obs *obs, int parent,
 double sp_division_dt(double dt_bar, int n_div, int m, int steps_since_division);
 
 /**
- * @brief N_max = meas(Omega) / m^0 (MODEL.md, growth source): the number of
+ * @brief N_max = meas(Omega) / m^0 (docs/model.md, growth source): the number of
  *        birth-size cells that fill Omega.
  *
  * Rounded down (a cell more than fits would have no room), after adding a

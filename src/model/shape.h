@@ -1,6 +1,6 @@
 /**
  * @file shape.h
- * @brief The shape penalty on principal moments of inertia (MODEL.md "Shape
+ * @brief The shape penalty on principal moments of inertia (docs/model.md "Shape
  *        penalty", paper section 3), explicit in time as in the paper, or
  *        linearised implicit (shape.scheme; softpack_solver.h, the gains),
  *        on a 2D or a 3D mesh (n = dim principal moments):

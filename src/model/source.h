@@ -1,6 +1,6 @@
 /**
  * @file source.h
- * @brief The adaptive growth source (MODEL.md "Growth source", the paper's
+ * @brief The adaptive growth source (docs/model.md "Growth source", the paper's
  *        algorithm 3): s_k = s_bar inside omega_k, 0 outside, and switched
  *        off for good once no new cell can be created and the cell has grown
  *        past ratio_off x its birth mass.
@@ -24,7 +24,7 @@ extern "C" {
 #define SP_SOURCE_RATIO_OFF_PAPER 1.1
 
 /** A cell's interior omega_k is where c_k >= 1/2: its membrane is the 1/2
- *  level set (MODEL.md "Fields and energy"). */
+ *  level set (docs/model.md "Fields and energy"). */
 #define SP_SOURCE_INTERIOR_LEVEL 0.5
 
 /**
@@ -33,7 +33,7 @@ extern "C" {
  * source_per_pair[p] = s_bar where the pair's cell has its source on and
  * c^n >= 1/2 at the pair's node, else 0. The indicator is evaluated with
  * c^n, not c^{n+1}: a source that switches with the unknown would make the
- * Newton residual non-smooth (MODEL.md).
+ * Newton residual non-smooth (docs/model.md).
  *
  * @param[in] layout the pairs
  * @param[in] state_old c^n, mu^n in layout order (2 n_pairs values)

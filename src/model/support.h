@@ -1,6 +1,6 @@
 /**
  * @file support.h
- * @brief Local supports (beyond the paper; MODEL.md "Beyond the paper"):
+ * @brief Local supports (beyond the paper; docs/model.md "Beyond the paper"):
  *        each cell's field lives on the whole elements within a margin of
  *        its core (c_k >= core threshold), and the support follows the cell.
  *

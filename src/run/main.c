@@ -132,7 +132,7 @@ static int draw_progress(const sp_step_info *s, void *user) {
  * They are blocked in every thread from the first line of main, before
  * MPI_Init starts Open MPI's threads, and taken by a thread of their own
  * (sigwait): no handler runs inside the solver. A handler is not enough
- * (issue 27, "SIGTERM: status 139"; tools/sigterm_in_metis.sh): Debian's
+ * ("SIGTERM: status 139"; tools/sigterm_in_metis.sh): Debian's
  * METIS (GKlib) installs its own SIGTERM handler for the length of
  * METIS_NodeND (gk_sigtrap) and longjmps out of it on a SIGTERM. METIS then
  * returns METIS_ERROR with the ordering unwritten, SuperLU_DIST (which does
@@ -199,7 +199,7 @@ static void hold_signals(void) {
   pthread_attr_init(&attr);
   pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
   if (pthread_create(&waiter, &attr, wait_stop_signals, NULL) != 0) {
-    /* no thread: the handler takes them, unblocked (as before issue 27) */
+    /* no thread: the handler takes them, unblocked */
     pthread_sigmask(SIG_UNBLOCK, &stop_signals, NULL);
   }
   pthread_attr_destroy(&attr);

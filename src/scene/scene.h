@@ -269,7 +269,7 @@ typedef struct {
 /** How the shape term enters a step (src/model/shape.h). */
 typedef enum { SP_SHAPE_EXPLICIT = 0, SP_SHAPE_IMPLICIT = 1 } sp_shape_scheme;
 
-/** shape: the shape penalty on principal moments (MODEL.md, paper sec. 3). */
+/** shape: the shape penalty on principal moments (docs/model.md, paper sec. 3). */
 typedef struct {
   double delta1; /**< modulus on the larger principal moment I^1 */
   double delta2; /**< modulus on the second principal moment I^2 (the

@@ -546,7 +546,7 @@ static int check_lineage(const sp_scene *scene, const char *file) {
 }
 
 /** The initial layout (every cell on every node: a run starts with it, also
- *  before cutting local supports) must be numberable by ints and Epetra's
+ *  before cutting local supports) must be numberable by ints and the solver's
  *  32-bit global ids; checked here, before anything that large is allocated. */
 static int check_sizes(const sp_scene *scene, int n_cells, const char *cells_key,
                        const char *file) {
@@ -571,7 +571,7 @@ static int check_sizes(const sp_scene *scene, int n_cells, const char *cells_key
   SP_CHECK(pairs <= SP_LAYOUT_MAX_PAIRS, SP_ERR_INPUT,
            "%s: %s and %s (%d cells): too large: %lld nodes x %d cells = %lld (cell, node) "
            "pairs in the initial layout, 2 x %lld unknowns; at most %d pairs fit the "
-           "solver's 32-bit indices (Epetra's global ids): use fewer elements or cells",
+           "solver's 32-bit indices (the solver's global ids are 32-bit): use fewer elements or cells",
            file, mesh_keys, cells_key, n_cells, nodes, n_cells, pairs, pairs,
            SP_LAYOUT_MAX_PAIRS);
   /* A run that keeps every cell on every node hands that layout to the
