@@ -19,7 +19,7 @@
 #include "check.h"
 #include "command.h"
 #include "public/error.h"
-#include "io/output.h"
+#include "io/vtu_read.h"
 #include "output_read.h"
 
 static const char *const box =

@@ -1,4 +1,4 @@
-/* Pictures of 3D states (src/io/render.c):
+/* Pictures of 3D states (src/io/render_surfaces.c, render_sections.c):
  *  - the c = 1/2 surface (sp_render_level_surface) of a sphere field (tanh
  *    profile) on box meshes of 8, 16, 32 hexahedra a side is closed (every
  *    edge in exactly two triangles, once each way: consistently turned),

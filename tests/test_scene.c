@@ -1,4 +1,4 @@
-/* test_scene: the scene file reader (src/scene/scene.c).
+/* test_scene: the scene file reader (src/scene/scene*.c).
  *
  * - a minimal scene gets every default of the key table;
  * - a scene setting every key gets every value;

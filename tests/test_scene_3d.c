@@ -123,7 +123,7 @@ int main(void) {
   CHECK(scene->n_cells == 5 && scene->layout.support == SP_SUPPORT_AUTO, "%d cells, support %d",
         scene->n_cells, scene->layout.support);
   sp_scene_destroy(&scene);
-  /* pictures are 3D too (render.c: sections and surfaces) */
+  /* pictures are 3D too (render_sections.c, render_surfaces.c) */
   CHECK_OK(load(NULL, "output: {pictures: true}\n", &scene));
   CHECK(scene->output.pictures == 1, "pictures %d", scene->output.pictures);
   sp_scene_destroy(&scene);

@@ -10,7 +10,7 @@
 
 #include "model/cells.h"
 #include "public/error.h"
-#include "io/output.h"
+#include "io/vtu_read.h"
 
 static int ends_with(const char *s, const char *tail) {
   const size_t n = strlen(s), m = strlen(tail);
@@ -493,7 +493,7 @@ static double grid_sample(const sp_label_grid *g, const double *sd, const double
 static double label_profile(int k, const double *point, int dim, void *ctx) {
   sp_label_fields *lf = ctx;
   const sp_label_grid *g = lf->grid;
-  (void)dim; /* the grid's: scene.c pairs a label image with 2D, a volume with 3D */
+  (void)dim; /* the grid's: scene_check.c pairs a label image with 2D, a volume with 3D */
   double at[3];
   g->to_grid(g, point, at);
   for (int a = 0; a < g->dim; ++a)

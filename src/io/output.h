@@ -49,19 +49,6 @@ typedef struct {
 int sp_output_resume(const char *dir, int dim, int step, int named, int n_fields,
                      const sp_output_field *fields, sp_output *out);
 
-/** What sp_vtu_read finds in a softpack .vtu: the points (x, y, z; z = 0
- *  from a 2D mesh) and every cell's c and mu at them (cell-major:
- *  c[k n_points + i]). */
-typedef struct {
-  int n_points, n_cells;
-  double *xyz, *c, *mu;
-} sp_vtu_fields;
-
-/** @brief Read a .vtu softpack wrote on one process (fields_<step>.vtu).
- *         SP_ERR_INPUT if it is not one. */
-int sp_vtu_read(const char *path, sp_vtu_fields *out);
-void sp_vtu_fields_free(sp_vtu_fields *v);
-
 /** @brief The fields files written so far, in order (a checkpoint saves
  *         them): their number, and *fields. */
 int sp_output_fields_list(sp_output out, const sp_output_field **fields);

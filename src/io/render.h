@@ -3,6 +3,12 @@
  * @brief PNG pictures (cairo): the cells in the paper's colours (the field
  *        phi = max_k c_k on a jet colour map: interiors red, membranes
  *        cyan-yellow, background blue) and the energy against time.
+ *
+ * One file per picture, on a drawing base of their own (render_base.h,
+ * private to io/): render_2d.c (sp_render_cells), render_plot.c
+ * (sp_render_energy), render_sections.c (sp_render_sections),
+ * render_surfaces.c (sp_render_level_surface, sp_render_surfaces) and
+ * render_contacts.c (sp_render_contact_graph).
  */
 #ifndef SP_RENDER_H
 #define SP_RENDER_H

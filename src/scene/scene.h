@@ -3,7 +3,7 @@
  * @brief The input deck: a YAML scene file read through a libcyaml schema,
  *        validated (types, ranges, cells inside the domain), with
  *        `--set section.key=value` overrides. Every key, its unit, default
- *        and range live in one table in scene.c; docs/scene.md is printed
+ *        and range live in one table in scene_keys.c; docs/scene.md is printed
  *        from that table (`softpack keys`).
  */
 #ifndef SP_SCENE_H

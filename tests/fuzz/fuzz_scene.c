@@ -1,4 +1,4 @@
-/* libFuzzer target for the scene reader (src/scene/scene.c): any bytes, read as
+/* libFuzzer target for the scene reader (src/scene/scene*.c): any bytes, read as
  * a scene file's text, must give SP_OK or SP_ERR_INPUT with a message, never
  * a crash, a sanitizer report, a hang or another error code. Built by
  * -DSOFTPACK_FUZZ=ON with clang and run by `tools/softpack.sh fuzz`
