@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "base/memory.hpp"
 #include "linear/linear.hpp"
 
 namespace sp {
@@ -38,6 +39,9 @@ namespace {
 #define SP_ICNTL(I) icntl[(I) - 1]
 #define SP_CNTL(I) cntl[(I) - 1]
 #define SP_INFOG(I) infog[(I) - 1]
+#define SP_INFO(I) info[(I) - 1]
+// "no limit known" for does_not_fit (MB)
+constexpr double kUnknownMemory = 1e300;
 
 constexpr int kJobInit = -1, kJobEnd = -2, kJobAnalyse = 1, kJobFactor = 2, kJobSolve = 3;
 constexpr int kLeanRelaxation = 20;  // ICNTL(14) as MUMPS itself sets it (unsymmetric, one process)
@@ -48,6 +52,7 @@ class MumpsSolver final : public LinearSolver {
     MPI_Comm_dup(comm, &comm_);
     MPI_Comm_rank(comm_, &rank_);
     MPI_Comm_size(comm_, &size_);
+    MPI_Comm_split_type(comm_, MPI_COMM_TYPE_SHARED, rank_, MPI_INFO_NULL, &machine_);
     id_ = DMUMPS_STRUC_C();
     id_.comm_fortran = (MUMPS_INT)MPI_Comm_c2f(comm_);
     id_.par = 1;  // the host works too
@@ -62,6 +67,7 @@ class MumpsSolver final : public LinearSolver {
       id_.job = kJobEnd;  // collective, as the solver's destruction is
       dmumps_c(&id_);
     }
+    MPI_Comm_free(&machine_);
     MPI_Comm_free(&comm_);
   }
 
@@ -91,6 +97,19 @@ class MumpsSolver final : public LinearSolver {
     }
     if (size_ == 1) id_.a = A.val;  // only read, during this call
     else id_.a_loc = A.val;
+    if (does_not_fit(why)) {
+      if (relaxation_ <= kLeanRelaxation) return false;
+      // The estimate counts the workspace's relaxation, room for delayed
+      // pivots that is mostly never touched: with what MUMPS itself sets it
+      // may fit (then kept, as after a refused allocation). A new analysis
+      // gives its estimate.
+      relaxation_ = kLeanRelaxation;
+      id_.SP_ICNTL(14) = relaxation_;
+      id_.job = kJobAnalyse;
+      dmumps_c(&id_);
+      ++symbolic_;
+      if (failed("analysis", why) || does_not_fit(why)) return false;
+    }
     id_.job = kJobFactor;
     dmumps_c(&id_);
     if (id_.SP_INFOG(1) == -13 && relaxation_ > kLeanRelaxation) {
@@ -185,6 +204,33 @@ class MumpsSolver final : public LinearSolver {
     id_.SP_CNTL(1) = 0.01;  // relative pivoting threshold
   }
 
+  // Whether the factorisation would not fit in the memory the machine still
+  // offers this job (memory.hpp): the analysis's estimate (INFO(15), MB,
+  // this rank's, in-core) summed over the ranks on this machine, against
+  // the least any of them may still use. A factorisation that does not fit
+  // is not started (out_of_memory(), why says what it needs and what is
+  // left): on a machine that overcommits, its allocations would succeed
+  // and the kernel's OOM killer end the run when they are touched. Called
+  // on every rank alike (collective over the machine's ranks).
+  bool does_not_fit(std::string &why) {
+    double need = id_.SP_INFO(15) > 0 ? id_.SP_INFO(15) : 0.0, on_machine = 0;
+    std::string source;
+    const double available = available_memory_mb(&source);
+    double left = available < 0 ? kUnknownMemory : available;
+    MPI_Allreduce(&need, &on_machine, 1, MPI_DOUBLE, MPI_SUM, machine_);
+    MPI_Allreduce(MPI_IN_PLACE, &left, 1, MPI_DOUBLE, MPI_MIN, machine_);
+    if (left >= kUnknownMemory || on_machine <= left) return false;
+    char text[320];
+    snprintf(text, sizeof text,
+             "MUMPS: its factorisation needs about %.0f MB on this machine (its analysis's "
+             "estimate, %d%% workspace relaxation) and %.0f MB are left (%s): out of memory, "
+             "not started",
+             on_machine, relaxation_, left, source.empty() ? "the least on its ranks" : source.c_str());
+    why = text;
+    out_of_memory_ = true;
+    return true;
+  }
+
   // After a call: true (and why) when MUMPS reports an error. INFOG is
   // global: every rank sees the same.
   bool failed(const char *phase, std::string &why) {
@@ -210,7 +256,7 @@ class MumpsSolver final : public LinearSolver {
     return true;
   }
 
-  MPI_Comm comm_;
+  MPI_Comm comm_, machine_;  // the solver's ranks; those of them on this machine
   int rank_ = 0, size_ = 1;
   DMUMPS_STRUC_C id_;
   bool started_ = false, analysed_ = false, factored_ = false, out_of_memory_ = false;
