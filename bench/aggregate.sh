@@ -11,7 +11,7 @@
 # 2-core machine the run reaches 256 cells in about 10 minutes and its t_end in
 # about 23 (2.6 GB on rank 0);
 # the table comes from what energy.csv holds, so a run stopped early can
-# be tabled with --reuse (docs/local-support.md, "Scale").
+# be tabled with --reuse (docs/local-support.md, "What it costs and saves").
 #   bench/aggregate.sh [--reuse] [--set key=value ...]
 #     (--reuse: tables and pictures of an earlier run; --set: scene overrides)
 #   NP=2 bench/aggregate.sh         (under mpirun -np 2)

@@ -1,6 +1,5 @@
 #!/usr/bin/env bash
-# The 3D C. elegans scene at refinements 3 (docs/embryo.md, "3D at
-# refinements 3") with P1's cut along a fixed normal (cos B, sin B, 0), B
+# The 3D C. elegans scene at refinements 3 (docs/embryo.md, "The C. elegans 8-cell scene") with P1's cut along a fixed normal (cos B, sin B, 0), B
 # degrees from the egg's axis towards ABp's side (+y: EMS, the first
 # daughter, goes to the side the normal points away from, ABa's), to the
 # end of the 4-cell stage (t_end 0.0041, 41 min; ABa and ABp divide at 40

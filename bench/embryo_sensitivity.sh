@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # How the 2D C. elegans scene's 4-cell stage changes with the shell's aspect
-# ratio and with the cuts' axes (docs/embryo.md, "Sensitivity"): the scene
+# ratio and with the cuts' axes (docs/embryo.md, "The C. elegans 8-cell scene"): the scene
 # inputs/embryo/celegans_8_2d.yaml run to t = 0.0084 (the 4-cell stage,
 # before ABa and ABp divide; about 4 s of CPU a run) with the shell's
 # semi_y in 0.25 0.30 0.35 (semi_x 0.5; P0's semi-axes scaled with it, so

@@ -17,8 +17,7 @@ units the scene names: um, min) and prints, in Markdown:
   - the contacts of those stages: each pair's contact (contacts.csv) in the
     scene's unit and as a fraction of each of the two cells' diffuse
     surfaces, beside the published ones: PUBLISHED holds the contact
-    fractions that can be cited (none found: docs/embryo.md, "Contacts
-    against the atlas", says what was searched; the column prints "-"),
+    fractions that can be cited (none found: docs/embryo.md, "The C. elegans 8-cell scene", says what was searched; the column prints "-"),
     and TOUCHES whether the pair touches in the embryo where a source says
     so (the 4-cell "diamond": ABa does not touch P2, the other five pairs
     do; Giammona and Campas 2021, PLoS Comput Biol 17:e1007994, Fig 1A);
@@ -30,7 +29,7 @@ units the scene names: um, min) and prints, in Markdown:
     (their c = 1/2 surfaces meet between nodes); cells with a third one
     between them, its width. A test of touching that does not read the
     diffuse fields' gradients far from the membranes, as the contact
-    measure does (docs/embryo.md, "3D at refinements 3").
+    measure does (docs/embryo.md, "The C. elegans 8-cell scene").
 """
 import base64
 import csv
@@ -45,7 +44,7 @@ ATLAS = {"P0": 20769, "AB": 12304, "P1": 8465, "ABa": 6195, "ABp": 6109, "EMS": 
          "E": 2249, "C": 2368, "P3": 1157}
 
 # Published contact fractions by pair (frozenset of names): none could be
-# cited after two searches (docs/embryo.md, "Contacts against the atlas",
+# cited after two searches (docs/embryo.md, "The C. elegans 8-cell scene",
 # which also quotes an unpublished one-embryo reading that is not put here).
 PUBLISHED = {}
 

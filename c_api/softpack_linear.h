@@ -9,7 +9,7 @@
  * cxx_glue/linear/linear_NAME.cpp, which defines
  *     std::unique_ptr<sp::LinearSolver> sp::make_linear_NAME(MPI_Comm, const sp_solver_options &);
  *     const char *sp::linear_NAME_version(bool *available);
- * (docs/design.md, "Extension points").
+ * (docs/design.md, "The glue").
  *
  * SP_LINEAR_SOLVERS(X) calls X(ID, NAME, RANKS) for each, in the order
  * `softpack keys` lists them: ID names the enum value SP_LINEAR_ID (the

@@ -484,7 +484,7 @@ int main(int argc, char **argv) {
           m1[k]);
   /* the same push with the interior restore: the same masses kept, and the
    * potential restore (the default) raises the energy less at its changes
-   * (docs/local-support.md, "Where a change restores the mass") */
+   * (docs/local-support.md, "How it works") */
   const char *interior_set[] = {"layout.restore=interior"};
   sp_run_summary pi = run("local_push.yaml", 1, interior_set, "local_push_interior");
   printf("pushed cell, layout.restore interior: %d support changes, largest energy rise at a "

@@ -20,7 +20,7 @@
  *    printed;
  *  - layout.support: auto is local when divisions can make more than 4
  *    cells and full when they cannot, as in 2D;
- *  - coarse meshes (docs/local-support.md, "Coarse meshes"): supports
+ *  - coarse meshes (docs/local-support.md, "What differs from full supports"): supports
  *    computed from a sphere of radius 0.24 in the ellipsoid 0.5 x 0.25 x
  *    0.25 (kappa 1e-3, margin 8 d, band 4 d) need an update right after
  *    they are built at refinements 3 (elements up to 0.107 > margin - band
@@ -345,8 +345,7 @@ static int unheld_beside_ring(const sp_mesh *mesh, const sp_layout *layout, int 
   return n;
 }
 
-/* layout.buffer_elements (docs/local-support.md, "The buffer ring's
- * elements"): a tanh sphere of radius 0.2 at (0.22, 0, 0) in the 3D run
+/* layout.buffer_elements (docs/local-support.md, "How it works"): a tanh sphere of radius 0.2 at (0.22, 0, 0) in the 3D run
  * 5's ellipsoid at refinements 4, its support reaching the eggshell's
  * ring. By the margin alone the support has edge nodes beside ring
  * elements it does not count and in none it counts (their far field sits

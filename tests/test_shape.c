@@ -288,7 +288,7 @@ static void test_round(void) {
    * at c^n: the potential of the linear functional L(c) = -sum_i coef_i
    * J_i(c), J_i(c) = int_mask Ihat_i c. The step is then the minimiser of
    * Pi_CH(c) + L(c) + |c - c^n|^2_{H^-1} / (2 M dt), as the step without
-   * the term is of the same without L (docs/model.md, "Energy";
+   * the term is of the same without L (docs/model.md, "Fields and energy";
    * tests/test_energy.c), so
    *     Pi_CH(c^n+1) - Pi_CH(c^n) <= -(L(c^n+1) - L(c^n)) = sum_p D_p (c^n+1_p - c^n_p),
    * D_p = sum_i coef_i int N_p Ihat_i: the term's part of the mu residual

@@ -11,6 +11,8 @@
 # 2. The user-facing text (README.md, docs/*.md, the C core's string
 #    literals) names none of the Trilinos packages softpack no longer uses
 #    (Epetra, AztecOO, Ifpack without the 2, ML, Amesos v1).
+# 3. A section quoted as `docs/PAGE.md, "Heading"` (in docs and comments,
+#    over line breaks too) is the start of one of PAGE's headings.
 # docs/reports/ is left out of both: a report is the record of a study,
 # written once, and may name what existed then.
 # Exit status: 0 with "check_refs: OK ...", 1 with a line per dead
@@ -118,6 +120,22 @@ if [ -s "${TMPDIR:-/tmp}/check_refs.$$" ]; then
   bad=$((bad + $(wc -l < "${TMPDIR:-/tmp}/check_refs.$$")))
 fi
 rm -f "${TMPDIR:-/tmp}/check_refs.$$"
+
+# 3. quoted sections
+sections=$(perl -0777 -ne '
+  while (/(docs\/[a-z0-9-]+\.md),\s+"([^"]+)"/g) {
+    my ($page, $heading) = ($1, $2);
+    $heading =~ s/\s*(?:\n\s*(?:#|\*|\/\/)?\s*)+/ /g;   # a quote over lines of a comment
+    my $line = 1 + (substr($_, 0, pos($_)) =~ tr/\n//);
+    print "$ARGV:$line\t$page\t$heading\n";
+  }' "${docs[@]}" "${sources[@]}" 2> /dev/null || true)
+while IFS=$'\t' read -r where page heading; do
+  [ -n "$where" ] || continue
+  checked=$((checked + 1))
+  [ -f "$page" ] || { report "$where: quotes a section of $page, which does not exist"; continue; }
+  grep -E '^#+ ' "$page" | sed -E 's/^#+ +//' | grep -qF -- "$heading" ||
+    report "$where: quotes the section \"$heading\" of $page, which has no such heading"
+done <<< "$sections"
 
 if [ "$bad" -gt 0 ]; then
   echo "check_refs: FAIL, $bad dead reference(s) or removed package name(s) ($checked references checked)"

@@ -10,7 +10,7 @@
 # unwritten; SuperLU_DIST's get_metis_dist does not look at the return
 # code and factorises with that garbage column permutation: a segfault in
 # sp_colorder, and the stop request never reached softpack (no checkpoint,
-# no message). docs/restart.md, "The two-process SIGTERM crash".
+# no message). docs/reports/2026-12-02-sigterm-in-metis.md.
 #
 # The script starts the ctest's two-process run, waits for step K, attaches
 # gdb to rank RANK, stops it inside its next METIS_NodeND (after GKlib's

@@ -3,10 +3,9 @@
 // dropped (the repulsion's d mu_k / d c_l, l != k), factored exactly by
 // MUMPS. That matrix is block diagonal, one block (c_k, mu_k) per cell, so
 // its LU has no fill between cells: the 3D 8-cell stage whose coupled LU
-// MUMPS could not allocate (docs/3d.md, "Direct solvers in 3D") factors as
+// MUMPS could not allocate (docs/3d.md, "Solvers in 3D") factors as
 // eight one-cell problems. The cells couple only where their
-// interfaces overlap, so GMRES needs few iterations (docs/3d.md, "GMRES on
-// the cells' blocks").
+// interfaces overlap, so GMRES needs few iterations (docs/3d.md, "Solvers in 3D").
 //
 // One MUMPS instance factors all blocks at once (its ordering finds the
 // independent blocks); under MPI the rows stay distributed as they are.

@@ -15,7 +15,7 @@
 // = 7), row and column iterative scaling (ICNTL(8) = 7, what Amesos sets),
 // no iterative refinement, workspace relaxation 100% (ICNTL(14): delayed
 // pivots need room; 20% from the first factorisation whose workspace
-// could not be allocated with 100%: docs/3d.md, "Refinements 5"), the
+// could not be allocated with 100%: docs/3d.md, "Solvers in 3D"), the
 // pivoting threshold CNTL(1) = 0.01 (MUMPS' default for unsymmetric
 // matrices). Unlike Amesos, which ends the process
 // on any MUMPS error, a failed factorisation or solve returns false with

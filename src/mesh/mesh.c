@@ -1,7 +1,7 @@
 /**
  * @file mesh.c
  * @brief Rectangle meshes, the paper's five-patch disk mapped to an
- *        ellipse (docs/model.md, "Mesh of the paper's runs" and "Buffer zone"),
+ *        ellipse (docs/model.md, "Discretisation" and "Buffer zone"),
  *        and in 3D hexahedral boxes and its twin, the cubed ball
  *        mapped to an ellipsoid (docs/3d.md).
  *

@@ -4,7 +4,7 @@
  *        coordinate bisection (RCB) order, and each rank given a contiguous
  *        range of that order holding an equal share of the unknowns.
  *
- * Why RCB and why this way (docs/parallel.md, "Partition"):
+ * Why RCB and why this way (docs/parallel.md, "What is distributed"):
  * - the solvers want each rank's rows to be one contiguous block of the
  *   global numbering in rank order (SuperLU_DIST's NRformat_loc, Amesos);
  *   the layout numbers unknowns node-major, so contiguous node ranges give

@@ -728,7 +728,7 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
    * supports would change at every step. Each such cell's support is
    * widened by one more layer of elements until none is (a support that
    * covers the mesh has no edge, so this ends). Supports that do not call
-   * for one are as computed (docs/local-support.md, "Coarse meshes"). */
+   * for one are as computed (docs/local-support.md, "What differs from full supports"). */
   while (rc == SP_OK && outgrown) {
     sp_layout_destroy(new_layout);
     free(*new_state);

@@ -108,7 +108,7 @@ int sp_support_fill(sp_support s, const sp_layout *layout, const double *state,
  * element's width of its margin, new nodes start from the far field) is
  * widened by layers of elements until it does not, so the supports just
  * rebuilt never call for another change before the cells move
- * (docs/local-support.md, "Coarse meshes"). Shrinking drops
+ * (docs/local-support.md, "What differs from full supports"). Shrinking drops
  * the far field c_k keeps outside its cell (its Gibbs-Thomson level, not 0)
  * and puts that mass back into the cell, which costs mu x (mass) against
  * the f(c) x (area) removed: the energy rises (docs/local-support.md).

@@ -22,7 +22,7 @@ typedef char sp_cell_name[SP_CELL_NAME_MAX];
  *  entries in 2D too (the unused ones 0). */
 #define SP_DIM_MAX 3
 
-/** Observables of one cell, the same in 2D and 3D (docs/model.md, "Cells";
+/** Observables of one cell, the same in 2D and 3D (docs/model.md, "Observables";
  *  Xb = X - centre, the sums over the mesh's dim coordinates). */
 typedef struct {
   double mass;      /**< m_k = int c_k dV (the conserved quantity) */

@@ -27,8 +27,8 @@ void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt)
   static const int jacobian[] = {SP_SOLVER_JAC_AD, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD};
   opt->jacobian = jacobian[scene->solver.jacobian];
   /* auto: the cells' blocks in 3D, where a direct LU of the coupled
-   * cells runs out of memory, MUMPS in 2D (docs/3d.md, "GMRES on the
-   * cells' blocks") */
+   * cells runs out of memory, MUMPS in 2D (docs/3d.md, "Solvers in
+   * 3D") */
   opt->linear = scene->solver.linear == SP_LINEAR_AUTO
                     ? (sp_scene_dim(scene) == 3 ? SP_LINEAR_GMRES_CELLS : SP_LINEAR_MUMPS)
                     : (int)scene->solver.linear;
