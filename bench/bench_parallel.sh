@@ -63,7 +63,7 @@ run() {
     awk -F, -v t0="$WINDOW_T0" 'NR > 1 && $2 > t0 { ++n; its += $4; s += $12; a += $13; f += $14; v += $15 }
       END { printf "%d %d %.3f %.3f %.3f %.3f ", n, its, s, a, f, v }' "$dir/out/energy.csv"
   else
-    sed -n 's/^softpack: \([0-9]*\) steps .* \([0-9]*\) Newton iterations, \([0-9.]*\) s (assembly \([0-9.]*\), factorisation \([0-9.]*\), solves \([0-9.]*\)).*/\1 \2 \3 \4 \5 \6/p' \
+    sed -n 's/^softpack: \([0-9]*\) steps .* \([0-9]*\) Newton iterations.*, \([0-9.]*\) s (assembly \([0-9.]*\), factorisation \([0-9.]*\), solves \([0-9.]*\)).*/\1 \2 \3 \4 \5 \6/p' \
       "$dir/log" | tr '\n' ' '
   fi
   local unknowns
