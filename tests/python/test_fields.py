@@ -1,12 +1,11 @@
 """Fields as numpy arrays match what the run wrote: the .vtu reader's c_k
 integrated over the mesh (2x2 / 2x2x2 Gauss on the Q1 elements) gives
-cells.csv's masses and centres, in 2D and 3D; with libsoftpack 0.2 the
+cells.csv's masses and centres, in 2D and 3D; the
 callback's StepInfo.field(k) and mesh() equal the .vtu of that step."""
 import numpy as np
 import pytest
 
 import softpack
-from softpack import _capi
 
 
 def gauss_integrals(fields, k, threshold=0.05):
@@ -88,8 +87,6 @@ def test_vtu_fields_3d(source_dir, tmp_path):
     assert centre[:2] == pytest.approx([want["xc"][0], want["yc"][0]], rel=1e-8)
 
 
-@pytest.mark.skipif(not _capi.library().has_fields,
-                    reason="StepInfo.field/mesh need libsoftpack 0.2 (sp_step_cell_field)")
 def test_step_fields_equal_vtu(small, tmp_path):
     got = {}
 

@@ -210,10 +210,7 @@ def test_names(small, tmp_path):
     r = softpack.run(small, out=tmp_path / "o", overrides={"time.max_steps": 2},
                      on_step=lambda s: seen.append(s.names))
     assert r.fields().names == ["AB", "P1"]
-    if softpack._capi.library().api >= (0, 2):
-        assert seen == [["AB", "P1"]] * 2
-    else:
-        assert seen == [["", ""]] * 2
+    assert seen == [["AB", "P1"]] * 2
 
 
 def test_solver_failure_raises_with_state(small, tmp_path):

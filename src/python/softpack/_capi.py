@@ -2,8 +2,8 @@
 
 Everything that depends on the C layout is in this module: the structures
 of run_types.h and cell_obs.h, the functions of run.h and error.h, and how
-the library is found.  The API version (sp_version(): "0.1" or "0.2")
-selects the layout of sp_cell_obs and the tail of sp_step_info.
+the library is found.  The layouts are those of API 0.2 (API below); a
+library of another version (sp_version()) is refused when loaded.
 
 The library is looked for, in order (the first that exists wins):
 
@@ -24,6 +24,7 @@ import re
 
 import numpy as np
 
+API = (0, 2)  # the MAJOR.MINOR of libsoftpack whose headers this module mirrors
 SP_MAX_NEWTON_HISTORY = 64
 SP_CELL_NAME_MAX = 32
 
@@ -46,18 +47,8 @@ class Attempt(ctypes.Structure):
                 ("dt_next", ctypes.c_double)]
 
 
-class CellObs01(ctypes.Structure):
-    """sp_cell_obs of API 0.1: 25 doubles."""
-    _fields_ = [(n, ctypes.c_double) for n in
-                ("mass", "mass_core", "xc", "yc", "zc", "Ixx", "Iyy", "Ixy", "Izz", "Ixz",
-                 "Iyz", "I1", "I2", "I3")] + \
-               [("v1", ctypes.c_double * 3), ("v2", ctypes.c_double * 3),
-                ("v3", ctypes.c_double * 3), ("angle", ctypes.c_double),
-                ("area", ctypes.c_double)]
-
-
-class CellObs02(ctypes.Structure):
-    """sp_cell_obs of API 0.2."""
+class CellObs(ctypes.Structure):
+    """sp_cell_obs (cell_obs.h)."""
     _fields_ = [("mass", ctypes.c_double),
                 ("mass_core", ctypes.c_double),
                 ("centre", ctypes.c_double * 3),
@@ -95,32 +86,23 @@ class RunSummary(ctypes.Structure):
                 ("stopped", ctypes.c_int)]
 
 
-def _step_info_fields(cell_obs, api):
-    fields = [("step", ctypes.c_int),
-              ("t", ctypes.c_double),
-              ("dt", ctypes.c_double),
-              ("t_end", ctypes.c_double),
-              ("n_cells", ctypes.c_int),
-              ("newton_its", ctypes.c_int),
-              ("failed_attempts", ctypes.c_int),
-              ("attempts", ctypes.POINTER(Attempt)),
-              ("error_estimate", ctypes.c_double),
-              ("cells", ctypes.POINTER(cell_obs)),
-              ("wall_seconds", ctypes.c_double),
-              ("last", ctypes.c_int)]
-    if api >= (0, 2):
-        fields += [("dim", ctypes.c_int),
-                   ("names", ctypes.POINTER(ctypes.c_char * SP_CELL_NAME_MAX)),
-                   ("run", ctypes.c_void_p)]
-    return fields
-
-
-class StepInfo01(ctypes.Structure):
-    _fields_ = _step_info_fields(CellObs01, (0, 1))
-
-
-class StepInfo02(ctypes.Structure):
-    _fields_ = _step_info_fields(CellObs02, (0, 2))
+class StepInfo(ctypes.Structure):
+    """sp_step_info (run_types.h)."""
+    _fields_ = [("step", ctypes.c_int),
+                ("t", ctypes.c_double),
+                ("dt", ctypes.c_double),
+                ("t_end", ctypes.c_double),
+                ("n_cells", ctypes.c_int),
+                ("newton_its", ctypes.c_int),
+                ("failed_attempts", ctypes.c_int),
+                ("attempts", ctypes.POINTER(Attempt)),
+                ("error_estimate", ctypes.c_double),
+                ("cells", ctypes.POINTER(CellObs)),
+                ("wall_seconds", ctypes.c_double),
+                ("last", ctypes.c_int),
+                ("dim", ctypes.c_int),
+                ("names", ctypes.POINTER(ctypes.c_char * SP_CELL_NAME_MAX)),
+                ("run", ctypes.c_void_p)]
 
 
 class Restart(ctypes.Structure):
@@ -189,10 +171,10 @@ class Library:
         lib = self.lib
         self.version = self._version()
         self.api = tuple(int(x) for x in self.version.split(".")[:2])
-        if self.api >= (0, 2):
-            self.CellObs, self.StepInfo = CellObs02, StepInfo02
-        else:
-            self.CellObs, self.StepInfo = CellObs01, StepInfo01
+        if self.api != API:
+            raise OSError(f"{self.path} is libsoftpack {self.version}; this package binds "
+                          f"{API[0]}.{API[1]} (install the two together: docs/python.md)")
+        self.CellObs, self.StepInfo = CellObs, StepInfo
         self.obs_dtype = np.dtype(self.CellObs)
         self.Callback = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(self.StepInfo),
                                          ctypes.c_void_p)
@@ -214,39 +196,28 @@ class Library:
         lib.sp_error_class_name.restype = ctypes.c_char_p
         lib.sp_error_class_name.argtypes = [ctypes.c_int]
         lib.sp_run_request_stop.restype = None
-        self.has_fields = hasattr(lib, "sp_step_mesh") and self.api >= (0, 2)
-        if self.has_fields:
-            lib.sp_step_mesh.restype = ctypes.c_int
-            # int sp_step_mesh(const sp_step_info *, int *dim, int *n_nodes,
-            #     const double **coords, int *n_elements, int *nodes_per_element,
-            #     const int **elements)
-            lib.sp_step_mesh.argtypes = [
-                ctypes.POINTER(self.StepInfo), ctypes.POINTER(ctypes.c_int),
-                ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
-                ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int),
-                ctypes.POINTER(ctypes.POINTER(ctypes.c_int))]
-            lib.sp_step_cell_field.restype = ctypes.c_int
-            lib.sp_step_cell_field.argtypes = [ctypes.POINTER(self.StepInfo), ctypes.c_int,
-                                               ctypes.POINTER(ctypes.c_double)]
+        lib.sp_step_mesh.restype = ctypes.c_int
+        # int sp_step_mesh(const sp_step_info *, int *dim, int *n_nodes,
+        #     const double **coords, int *n_elements, int *nodes_per_element,
+        #     const int **elements)
+        lib.sp_step_mesh.argtypes = [
+            ctypes.POINTER(self.StepInfo), ctypes.POINTER(ctypes.c_int),
+            ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.POINTER(ctypes.c_double)),
+            ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int),
+            ctypes.POINTER(ctypes.POINTER(ctypes.c_int))]
+        lib.sp_step_cell_field.restype = ctypes.c_int
+        lib.sp_step_cell_field.argtypes = [ctypes.POINTER(self.StepInfo), ctypes.c_int,
+                                           ctypes.POINTER(ctypes.c_double)]
 
     def _version(self):
         try:
             f = self.lib.sp_version
         except AttributeError:
-            f = None
-        if f is not None:
-            f.restype = ctypes.c_char_p
-            f.argtypes = []
-            v = f().decode()
-            if re.match(r"^\d+\.\d+", v):
-                return v
-        try:
-            from . import _build
-            return _build.VERSION
-        except ImportError:
-            pass
-        m = re.search(r"libsoftpack\.so\.(\d+\.\d+(?:\.\d+)?)", os.path.realpath(self.path))
-        return m.group(1) if m else "0.1"
+            raise OSError(f"{self.path} has no sp_version: a libsoftpack older than "
+                          f"{API[0]}.{API[1]}") from None
+        f.restype = ctypes.c_char_p
+        f.argtypes = []
+        return f().decode()
 
     def error_message(self):
         m = self.lib.sp_error_message()

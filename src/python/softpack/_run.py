@@ -101,12 +101,8 @@ class StepInfo:
         size = ctypes.sizeof(lib.CellObs)
         buf = ctypes.string_at(s.cells, n * size) if n else b""
         self._obs = np.frombuffer(buf, dtype=lib.obs_dtype, count=n)
-        if lib.api >= (0, 2):
-            self.dim = s.dim
-            self._names = [s.names[k].value.decode() for k in range(n)] if s.names else [""] * n
-        else:
-            self.dim = 3 if n and np.any(self._obs["Izz"] != 0) else 2
-            self._names = [""] * n
+        self.dim = s.dim
+        self._names = [s.names[k].value.decode() for k in range(n)] if s.names else [""] * n
         self._attempts = None
         if s.failed_attempts:
             self._attempts = []
@@ -139,24 +135,15 @@ class StepInfo:
 
     @property
     def centres(self):
-        o = self._obs
-        if self._lib.api >= (0, 2):
-            return o["centre"][:, :self.dim].copy()
-        return np.stack([o["xc"], o["yc"], o["zc"]], axis=1)[:, :self.dim]
+        return self._obs["centre"][:, :self.dim].copy()
 
     @property
     def moments(self):
-        o = self._obs
-        if self._lib.api >= (0, 2):
-            return o["moments"][:, :self.dim].copy()
-        return np.stack([o["I1"], o["I2"], o["I3"]], axis=1)[:, :self.dim]
+        return self._obs["moments"][:, :self.dim].copy()
 
     @property
     def axes(self):
-        o = self._obs
-        if self._lib.api >= (0, 2):
-            return o["axes"][:, :self.dim, :self.dim].copy()
-        return np.stack([o["v1"], o["v2"], o["v3"]], axis=1)[:, :self.dim, :self.dim]
+        return self._obs["axes"][:, :self.dim, :self.dim].copy()
 
     @property
     def long_axes(self):
@@ -166,26 +153,13 @@ class StepInfo:
 
     @property
     def inertia(self):
-        o = self._obs
-        if self._lib.api >= (0, 2):
-            return o["inertia"][:, :self.dim, :self.dim].copy()
-        full = np.empty((len(o), 3, 3))
-        full[:, 0, 0], full[:, 1, 1], full[:, 2, 2] = o["Ixx"], o["Iyy"], o["Izz"]
-        full[:, 0, 1] = full[:, 1, 0] = o["Ixy"]
-        full[:, 0, 2] = full[:, 2, 0] = o["Ixz"]
-        full[:, 1, 2] = full[:, 2, 1] = o["Iyz"]
-        return full[:, :self.dim, :self.dim]
+        return self._obs["inertia"][:, :self.dim, :self.dim].copy()
 
     @property
     def volumes(self):
-        o = self._obs
-        return (o["volume"] if self._lib.api >= (0, 2) else o["area"]).copy()
+        return self._obs["volume"].copy()
 
     def _need_live(self, what):
-        if not self._lib.has_fields:
-            raise NotImplementedError(f"StepInfo.{what} needs libsoftpack 0.2 "
-                                      f"(sp_step_mesh); this is {self._lib.version}: "
-                                      "read the fields from the run's .vtu (RunResult.fields)")
         if not self._live:
             raise RuntimeError(f"StepInfo.{what}: only during the callback that got it")
 
