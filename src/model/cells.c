@@ -172,15 +172,12 @@ int sp_cells_pair_weights(const sp_mesh *mesh, const sp_layout *layout, double *
 static void inertia(int dim, const double M[3][3], sp_cell_obs *o) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) o->inertia[i][j] = 0.0;
-  for (int i = 0; i < dim; ++i) {
-    int first = 1;
+  for (int i = 0; i < dim; ++i)
     for (int j = 0; j < dim; ++j) {
       if (j == i) continue;
-      o->inertia[i][i] = first ? M[j][j] : o->inertia[i][i] + M[j][j];
-      first = 0;
+      o->inertia[i][i] += M[j][j];
       o->inertia[i][j] = -M[i][j];
     }
-  }
   sp_cells_principal(dim, (const double(*)[3])o->inertia, o->moments, o->axes);
   o->long_axis = dim - 1;
 }
