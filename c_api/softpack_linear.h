@@ -37,7 +37,8 @@ typedef enum {
   X(KLU, klu, SP_LINEAR_GATHERED)                    \
   X(KLU2, klu2, SP_LINEAR_SERIAL)                    \
   X(GMRES_ILU, gmres_ilu, SP_LINEAR_PARALLEL)        \
-  X(GMRES_CELLS, gmres_cells, SP_LINEAR_PARALLEL)
+  X(GMRES_CELLS, gmres_cells, SP_LINEAR_PARALLEL)    \
+  X(GMRES_AMG, gmres_amg, SP_LINEAR_PARALLEL)
 
 /** The linear solvers, and `auto` (the scene's default: gmres_cells on a
  *  3D mesh, mumps on a 2D one; resolved when the run is set up). */

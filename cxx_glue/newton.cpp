@@ -588,6 +588,7 @@ void Solver::fill_jacobian(const sp_step_data &d, const double *x) {
   // dependence on the moments is the low-rank part (prepare_shape).
   assembly_->jacobian(shape_.data_at(d, *assembly_, full_.data()), full_.data(),
                       options_.jacobian, *jacobian_matrix_);
+  linear_->set_scales(d.dt * d.model.mobility, d.model.kappa);
   jacobian_fresh_ = true;
   if (carries()) {
     jac_x_ = full_;

@@ -45,6 +45,26 @@ static inline sp_model_params paper_model(void) {
   return m;
 }
 
+/** Two solvers' step from the same state, rep[0] and x0 the solver tested,
+ *  rep[1] and x1 the reference (@p names says which is which): the same
+ *  Newton iterations, the states equal to @p tol of the largest value of
+ *  x1; prints both. */
+static inline void check_same_step(const char *what, int step, const char *names,
+                                   const sp_step_report rep[2], const double *x0,
+                                   const double *x1, int n, double tol) {
+  double scale = 0, diff = 0;
+  for (int i = 0; i < n; ++i) {
+    scale = fmax(scale, fabs(x1[i]));
+    diff = fmax(diff, fabs(x0[i] - x1[i]));
+  }
+  printf("%s, step %d: Newton iterations %d / %d (%s), GMRES %ld; states differ by %.2e (of "
+         "%.3g)\n",
+         what, step, rep[0].newton_its, rep[1].newton_its, names, rep[0].linear_its, diff, scale);
+  CHECK(rep[0].newton_its == rep[1].newton_its, "%s, step %d: Newton iterations %d against %d",
+        what, step, rep[0].newton_its, rep[1].newton_its);
+  CHECK(diff <= tol * scale, "%s, step %d: states differ by %.3e", what, step, diff);
+}
+
 /** The tests' Newton options: tight tolerances, a new Jacobian every iteration. */
 static inline sp_solver_options test_options(int jacobian, int linear) {
   sp_solver_options opt = {.jacobian = jacobian, .linear = linear,

@@ -43,18 +43,8 @@ static void compare_with_superlu(const sp_mesh *mesh, const sp_layout *layout,
       CHECK(sp_solver_step(solvers[s], &data, x[s], &rep[s]) == 0, "%s, step %d: %s", what, step,
             rep[s].reason);
     }
-    double scale = 0, diff = 0;
-    for (int i = 0; i < n; ++i) {
-      scale = fmax(scale, fabs(x[1][i]));
-      diff = fmax(diff, fabs(x[0][i] - x[1][i]));
-    }
-    printf("%s, step %d: Newton iterations %d / %d (cells' blocks / SuperLU), GMRES %ld; "
-           "states differ by %.2e (of %.3g)\n",
-           what, step, rep[0].newton_its, rep[1].newton_its, rep[0].linear_its, diff, scale);
-    CHECK(rep[0].newton_its == rep[1].newton_its, "%s, step %d: Newton iterations %d against %d",
-          what, step, rep[0].newton_its, rep[1].newton_its);
+    check_same_step(what, step, "cells' blocks / SuperLU", rep, x[0], x[1], n, 1e-9);
     CHECK(rep[1].linear_its == 0, "SuperLU reports %ld GMRES iterations", rep[1].linear_its);
-    CHECK(diff <= 1e-9 * scale, "%s, step %d: states differ by %.3e", what, step, diff);
     *gmres_its += rep[0].linear_its;
     *newton_its += rep[0].newton_its;
   }

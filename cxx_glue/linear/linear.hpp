@@ -78,6 +78,12 @@ class LinearSolver {
   // work on the cells' blocks (uses_blocks()); the others ignore it.
   virtual bool uses_blocks() const { return false; }
   virtual void set_blocks(const int *, int) {}
+  // The scales of the next factorisation's Jacobian: its c rows are
+  // M dc + dt_mobility K dmu, its mu rows M dmu - (kappa K + W) dc
+  // (residual.hpp), W the mass matrix weighted by f''(c) and the pairs'
+  // terms. For the solvers that build a preconditioner from the blocks'
+  // structure; the others ignore it.
+  virtual void set_scales(double /*dt_mobility*/, double /*kappa*/) {}
 };
 
 // Serial SuperLU (dgstrf/dgstrs on the transposed CSC view of the CSR); one

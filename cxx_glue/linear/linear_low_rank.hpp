@@ -67,6 +67,9 @@ class LowRankSolver final : public LinearSolver {
   void set_blocks(const int *block_of_row, int n_global) override {
     sparse_->set_blocks(block_of_row, n_global);
   }
+  void set_scales(double dt_mobility, double kappa) override {
+    sparse_->set_scales(dt_mobility, kappa);
+  }
 
  private:
   // Z = A^-1 U and K's LU from the block solve [B, U] (X gets A^-1 B).

@@ -270,7 +270,9 @@ const sp_key sp_keys[] = {
              "docs/building.md) or GMRES with an ILU(k) preconditioner "
              "(gmres_ilu: Belos GMRES, Ifpack2 RILUK, one ILU per process) "
              "or with the Jacobian's cell-diagonal blocks factored by MUMPS "
-             "(gmres_cells: no fill between cells, docs/3d.md); auto: "
+             "(gmres_cells: no fill between cells, docs/3d.md) or with a "
+             "Cahn-Hilliard block preconditioner of AMG V-cycles (gmres_amg: "
+             "no factorisation, docs/solvers.md); auto: "
              "gmres_cells on a 3D mesh, mumps on a 2D one (the fastest "
              "measured in each, docs/3d.md)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
@@ -324,10 +326,11 @@ const sp_key sp_keys[] = {
             "cheapest that converges well)"),
     KEY_FLOAT(SP_SEC_SOLVER, "krylov_tol", solver.krylov_tol, 0.0, AT_LEAST(0.0), AT_MOST(1e-3),
               "-",
-              "gmres_ilu, gmres_cells: a linear solve ends when its residual is below this "
+              "gmres_ilu, gmres_cells, gmres_amg: a linear solve ends when its residual is below this "
               "fraction of the right-hand side's norm (a solve not there in "
               "500 iterations fails the Newton attempt); 0: the solver's "
-              "own, 1e-10 for gmres_ilu, 1e-4 for gmres_cells (docs/3d.md)"),
+              "own, 1e-10 for gmres_ilu, 1e-4 for gmres_cells (docs/3d.md), 1e-6 for "
+              "gmres_amg (docs/solvers.md)"),
     KEY_ENUM(SP_SEC_SOLVER, "predictor", solver.predictor, SP_PREDICT_LINEAR,
              sp_predictor_words, "-",
              "Newton's initial guess: the last state (none) or the last state "
