@@ -201,7 +201,7 @@ typedef struct {
   double t_factor;      /**< seconds: LU factorisations */
   double t_solve;       /**< seconds: triangular solves */
   double t_total;       /**< seconds: the whole step */
-  char reason[160];     /**< why it failed (empty when converged) */
+  char reason[512];     /**< why it failed (empty when converged) */
 } sp_step_report;
 
 /** Energy parts (docs/model.md); shape is added by the C core. */
