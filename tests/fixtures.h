@@ -96,6 +96,32 @@ static inline void expect_solver_refused(const sp_solver_options *opt, const cha
   sp_solver_destroy(&s);
 }
 
+/** A Krylov solver with @p opt at krylov_tol 1e-30 takes a step of 1e-4
+ *  (paper parameters) from @p x: the step fails at the first linear solve
+ *  (no Newton update, one factorisation, some GMRES iterations, a reason
+ *  naming GMRES) and leaves the state as it was. */
+static inline void check_unreachable_tolerance(const sp_mesh *mesh, const sp_layout *layout,
+                                               sp_solver_options opt, const double *x) {
+  opt.krylov_tol = 1e-30;
+  sp_solver strict = make_solver_opts(mesh, layout, &opt);
+  const int n = 2 * layout->n_pairs;
+  double *y = malloc(sizeof(double) * n), *old = malloc(sizeof(double) * n);
+  memcpy(y, x, sizeof(double) * n);
+  memcpy(old, x, sizeof(double) * n);
+  sp_step_data data = {.dt = 1e-4, .model = paper_model(), .state_old = old};
+  sp_step_report rep;
+  CHECK(sp_solver_step(strict, &data, y, &rep) == 1, "a step with krylov_tol 1e-30 succeeded");
+  printf("krylov_tol 1e-30: %s\n", rep.reason);
+  CHECK(rep.converged == 0 && rep.newton_its == 0 && rep.factorisations == 1 &&
+            rep.linear_its > 0 && strstr(rep.reason, "GMRES") != NULL,
+        "reason: %s; %d Newton iterations, %d factorisations, %ld GMRES iterations", rep.reason,
+        rep.newton_its, rep.factorisations, rep.linear_its);
+  CHECK(memcmp(y, x, sizeof(double) * n) == 0, "the failed step changed the state");
+  sp_solver_destroy(&strict);
+  free(y);
+  free(old);
+}
+
 /** A solver with direct solver @p linear (SP_SOLVER_*) on the mesh and layout. */
 static inline sp_solver make_solver_with(const sp_mesh *mesh, const sp_layout *layout,
                                          int jacobian, int linear) {

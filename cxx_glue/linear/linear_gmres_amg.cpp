@@ -33,12 +33,13 @@
 // b - A x sum to the mass the Newton update would lose (the c rows of A
 // sum, over a cell, to 1^T M dc: K's rows sum to zero). The solve adds to
 // each cell's c the constant that makes that sum zero (A's c-c block
-// summed over the cell is 1^T M 1 > 0), so each cell's mass is conserved
-// to round-off at any GMRES tolerance.
+// summed over the cell is 1^T M 1 > 0), and to its mu -Ml^-1 A_muc times
+// that constant so that the mu rows stay as the solve left them; each
+// cell's mass is conserved to round-off at any GMRES tolerance.
 //
-// The MueLu hierarchy is built at the first factorisation of a pattern
-// and afterwards only refreshed on the new values, keeping its
-// aggregates and tentative prolongator (MueLu's "reuse: type" tP).
+// The two MueLu hierarchies are built at the first factorisation of a
+// pattern and afterwards only refreshed on the new values, keeping their
+// aggregates and tentative prolongators (MueLu's "reuse: type" tP).
 #include <MueLu_CreateTpetraPreconditioner.hpp>
 #include <Teuchos_DefaultMpiComm.hpp>
 #include <Tpetra_Operator.hpp>
@@ -47,7 +48,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <exception>
 #include <stdexcept>
 #include <utility>
