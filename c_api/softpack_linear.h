@@ -40,8 +40,9 @@ typedef enum {
   X(GMRES_CELLS, gmres_cells, SP_LINEAR_PARALLEL)    \
   X(GMRES_AMG, gmres_amg, SP_LINEAR_PARALLEL)
 
-/** The linear solvers, and `auto` (the scene's default: gmres_cells on a
- *  3D mesh, mumps on a 2D one; resolved when the run is set up). */
+/** The linear solvers, and `auto` (the scene's default: mumps on a 2D
+ *  mesh, gmres_cells or from 15,000 nodes gmres_amg on a 3D one; resolved
+ *  when the run is set up, sp_linear_auto). */
 typedef enum {
 #define SP_LINEAR_ENUM_(id, name, ranks) SP_LINEAR_##id,
   SP_LINEAR_SOLVERS(SP_LINEAR_ENUM_)

@@ -187,25 +187,37 @@ static void test_every_key(void) {
   sp_scene_destroy(&s);
 }
 
-/* solver.linear auto: mumps on a 2D mesh, gmres_cells on a 3D one;
- * krylov_tol 0: 1e-10 for gmres_ilu, 1e-4 for gmres_cells, else as given */
+/* solver.linear auto: mumps on a 2D mesh, gmres_cells on a 3D one below
+ * SP_LINEAR_AUTO_AMG_NODES nodes and gmres_amg from there; krylov_tol 0:
+ * 1e-10 for gmres_ilu, 1e-4 for gmres_cells, 1e-6 for gmres_amg, else as
+ * given */
 static void test_linear_auto(void) {
+  CHECK(sp_linear_auto(2, 10000000) == SP_LINEAR_MUMPS, "auto in 2D on 1e7 nodes: mumps");
+  CHECK(sp_linear_auto(3, SP_LINEAR_AUTO_AMG_NODES - 1) == SP_LINEAR_GMRES_CELLS,
+        "auto in 3D below the crossover: gmres_cells");
+  CHECK(sp_linear_auto(3, SP_LINEAR_AUTO_AMG_NODES) == SP_LINEAR_GMRES_AMG,
+        "auto in 3D from the crossover: gmres_amg");
   const struct {
     const char *scene, *set[2];
     int linear;
     double tol;
+    long nodes;
   } cases[] = {
-      {"tests/scenes/ellipse_minimal.yaml", {NULL, NULL}, SP_LINEAR_MUMPS, 1e-10},
+      {"tests/scenes/ellipse_minimal.yaml", {NULL, NULL}, SP_LINEAR_MUMPS, 1e-10, 0},
       {"tests/scenes/ellipse_minimal.yaml", {"solver.linear=gmres_ilu", NULL},
-       SP_LINEAR_GMRES_ILU, 1e-10},
+       SP_LINEAR_GMRES_ILU, 1e-10, 0},
       {"tests/scenes/ellipse_minimal.yaml", {"solver.linear=gmres_cells", NULL},
-       SP_LINEAR_GMRES_CELLS, 1e-4},
-      {"tests/scenes/restart_3d.yaml", {NULL, NULL}, SP_LINEAR_GMRES_CELLS, 1e-4},
+       SP_LINEAR_GMRES_CELLS, 1e-4, 0},
+      {"tests/scenes/restart_3d.yaml", {NULL, NULL}, SP_LINEAR_GMRES_CELLS, 1e-4, 0},
       {"tests/scenes/restart_3d.yaml", {"solver.krylov_tol=1e-6", NULL}, SP_LINEAR_GMRES_CELLS,
-       1e-6},
+       1e-6, 0},
       {"tests/scenes/divide_3d.yaml", {"solver.linear=auto", "solver.krylov_tol=1e-6"},
-       SP_LINEAR_GMRES_CELLS, 1e-6},
-      {"tests/scenes/divide_3d.yaml", {"solver.linear=mumps", NULL}, SP_LINEAR_MUMPS, 1e-10},
+       SP_LINEAR_GMRES_CELLS, 1e-6, 0},
+      {"tests/scenes/divide_3d.yaml", {"solver.linear=mumps", NULL}, SP_LINEAR_MUMPS, 1e-10, 0},
+      {"tests/scenes/restart_3d.yaml", {NULL, NULL}, SP_LINEAR_GMRES_AMG, 1e-6, 50000},
+      {"tests/scenes/restart_3d.yaml", {"solver.linear=gmres_cells", NULL}, SP_LINEAR_GMRES_CELLS,
+       1e-4, 50000},
+      {"tests/scenes/ellipse_minimal.yaml", {NULL, NULL}, SP_LINEAR_MUMPS, 1e-10, 50000},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
     char path[PATH_SIZE];
@@ -213,7 +225,7 @@ static void test_linear_auto(void) {
     sp_scene *s = NULL;
     CHECK_OK(sp_scene_load(source_path(cases[i].scene, path), n_set, cases[i].set, &s));
     sp_solver_options opt;
-    sp_solver_options_from_scene(s, &opt);
+    sp_solver_options_from_scene(s, cases[i].nodes, &opt);
     CHECK(opt.linear == cases[i].linear && opt.krylov_tol == cases[i].tol,
           "%s %s %s: linear %d (want %d), krylov_tol %g (want %g)", cases[i].scene,
           cases[i].set[0] ? cases[i].set[0] : "", cases[i].set[1] ? cases[i].set[1] : "",

@@ -79,4 +79,17 @@ double available_memory_mb(std::string *source) {
   return best < 0 ? -1 : best / 1048576.0;
 }
 
+MachineMemory check_machine_memory(MPI_Comm machine, double need_mb) {
+  constexpr double kUnknown = 1e300;  // no limit known
+  MachineMemory m;
+  const double available = available_memory_mb(&m.source);
+  double left = available < 0 ? kUnknown : available, need = need_mb > 0 ? need_mb : 0.0;
+  MPI_Allreduce(&need, &m.need_mb, 1, MPI_DOUBLE, MPI_SUM, machine);
+  MPI_Allreduce(MPI_IN_PLACE, &left, 1, MPI_DOUBLE, MPI_MIN, machine);
+  m.left_mb = left;
+  m.fits = left >= kUnknown || m.need_mb <= left;
+  if (m.source.empty()) m.source = "the least on its ranks";
+  return m;
+}
+
 }  // namespace sp

@@ -4,6 +4,8 @@
 // OOM killer, with no message and nothing written).
 #pragma once
 
+#include <mpi.h>
+
 #include <string>
 
 namespace sp {
@@ -14,5 +16,17 @@ namespace sp {
 // memory.limit_in_bytes - memory.usage_in_bytes), the cgroup's ancestors
 // included; -1 when none can be read. @p source names the one that bounds it.
 double available_memory_mb(std::string *source);
+
+// A solver's estimate of what it is about to allocate, checked against what
+// the machine still offers: need_mb (this rank's) summed over the ranks of
+// @p machine (those on one machine: MPI_Comm_split_type SHARED), against
+// the least any of them may still use. Collective over machine.
+struct MachineMemory {
+  bool fits = true;      // also when no limit can be read
+  double need_mb = 0;    // summed over the machine's ranks
+  double left_mb = 0;    // the least left on any of them
+  std::string source;    // what bounds it (available_memory_mb's source)
+};
+MachineMemory check_machine_memory(MPI_Comm machine, double need_mb);
 
 }  // namespace sp

@@ -48,11 +48,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
+#include <new>
 #include <stdexcept>
 #include <utility>
 #include <vector>
 
+#include "base/memory.hpp"
 #include "linear/gmres.hpp"
 #include "linear/linear.hpp"
 #include "linear/tpetra_rows.hpp"
@@ -188,7 +191,12 @@ class AmgBlockSolver final : public LinearSolver {
   AmgBlockSolver(MPI_Comm comm, const KrylovOptions &o)
       : mpi_(comm), comm_(Teuchos::rcp(new Teuchos::MpiComm<int>(comm))), o_(o) {
     ensure_kokkos();
+    int rank = 0;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &machine_);
   }
+  ~AmgBlockSolver() override { MPI_Comm_free(&machine_); }
+  bool out_of_memory() const override { return out_of_memory_; }
 
   bool uses_blocks() const override { return true; }
   void set_blocks(const int *block_of_row, int n_global) override {
@@ -204,6 +212,7 @@ class AmgBlockSolver final : public LinearSolver {
 
   bool factor(const CsrRows &A, bool same_pattern, std::string &why) override {
     gmres_.set_factored(false);
+    out_of_memory_ = false;
     if ((int)block_.size() != A.n_global) {
       why = "CH blocks: the rows' cells were not given (set_blocks)";
       return false;
@@ -215,6 +224,9 @@ class AmgBlockSolver final : public LinearSolver {
     try {
       bool new_pattern = false;
       if (!rows_ || !same_pattern || !rows_->same_pattern(A)) {
+        rows_.reset();
+        amg_ = amg2_ = Teuchos::null;
+        if (does_not_fit(A, why)) return false;
         set_up(A);
         new_pattern = true;
       }
@@ -248,6 +260,13 @@ class AmgBlockSolver final : public LinearSolver {
       hierarchy(amg2_, p2_, new_pattern);
       prec_->set(b_.rows->matrix().get(), c_.rows->matrix().get(), amg_.get(), amg2_.get(),
                  &lumped_);
+    } catch (const std::bad_alloc &) {
+      rows_.reset();
+      amg_ = amg2_ = Teuchos::null;
+      why = "GMRES with the CH block preconditioner: set-up failed: out of memory (an "
+            "allocation refused)";
+      out_of_memory_ = true;
+      return false;
     } catch (const std::exception &e) {
       rows_.reset();
       amg_ = amg2_ = Teuchos::null;
@@ -268,6 +287,46 @@ class AmgBlockSolver final : public LinearSolver {
   int symbolic_count() const override { return set_ups_; }
 
  private:
+  // This rank's memory for a new pattern of A, in MB, before any of it is
+  // allocated: the GMRES basis (restart + 1 vectors and a few more), the
+  // Tpetra copy of A, the four pair matrices (host arrays and Tpetra
+  // copies) and the two MueLu hierarchies. Bytes per entry and the
+  // hierarchies' factor are this file's storage and MueLu's smoothed
+  // aggregation on these blocks as measured against the resident memory
+  // (docs/solvers.md, "Memory checked before it is spent").
+  double estimate_mb(const CsrRows &A) const {
+    const double n = A.n_rows, nnz = A.row_ptr[A.n_rows];
+    double pair_entries = 0;  // the cells' own entries of the c rows, per pair column
+    for (int i = 0; i < A.n_rows; i += 2) {
+      const int cell = block_[A.first_row + i];
+      for (int k = A.row_ptr[i]; k < A.row_ptr[i + 1]; ++k)
+        pair_entries += block_[A.col[k]] == cell;
+    }
+    pair_entries /= 2;
+    const double basis = (o_.restart + 6.0) * n * 8;
+    const double matrix = nnz * kTpetraEntry + n * 24;
+    const double pairs = pair_entries * (kPairHostEntry + 4 * kTpetraEntry) + n * 60;
+    const double hierarchies = 2 * kHierarchy * pair_entries * kTpetraEntry;
+    return (basis + matrix + pairs + hierarchies) / 1048576.0;
+  }
+
+  // Whether the set-up for A would not fit in the memory the machine still
+  // offers (memory.hpp); if so why says what it needs and what is left.
+  // Collective over the machine's ranks.
+  bool does_not_fit(const CsrRows &A, std::string &why) {
+    const MachineMemory m = check_machine_memory(machine_, estimate_mb(A));
+    if (m.fits) return false;
+    char text[320];
+    snprintf(text, sizeof text,
+             "GMRES with the CH block preconditioner: its matrices, multigrid hierarchies and "
+             "Krylov basis need about %.0f MB on this machine and %.0f MB are left (%s): out of "
+             "memory, not started",
+             m.need_mb, m.left_mb, m.source.c_str());
+    why = text;
+    out_of_memory_ = true;
+    return true;
+  }
+
   void hierarchy(Teuchos::RCP<MueLuOp> &amg, PairMatrix &p, bool new_pattern) {
     if (new_pattern || amg.is_null()) {
       Teuchos::ParameterList params = amg_params();
@@ -404,7 +463,10 @@ class AmgBlockSolver final : public LinearSolver {
     for (int i = 0; i < n; i += 2) x[i + 1] -= vv(i / 2, 0) / lumped_[i / 2];
   }
 
-  MPI_Comm mpi_;
+  static constexpr double kTpetraEntry = 24;    // value, local column, slot table
+  static constexpr double kPairHostEntry = 72;  // PairMatrix's arrays, P1, P2, b K, C together
+  static constexpr double kHierarchy = 3;       // a hierarchy's entries per entry of its matrix
+  MPI_Comm mpi_, machine_;
   Teuchos::RCP<const Teuchos::Comm<int>> comm_;
   KrylovOptions o_;
   double g_ = 0, b_scale_ = 0;  // P1 = M + g K; b = dt mobility
@@ -421,6 +483,7 @@ class AmgBlockSolver final : public LinearSolver {
   Gmres gmres_;
   long iterations_ = 0;
   int set_ups_ = 0;
+  bool out_of_memory_ = false;
 };
 
 }  // namespace

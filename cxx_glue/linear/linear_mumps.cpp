@@ -40,9 +40,6 @@ namespace {
 #define SP_CNTL(I) cntl[(I) - 1]
 #define SP_INFOG(I) infog[(I) - 1]
 #define SP_INFO(I) info[(I) - 1]
-// "no limit known" for does_not_fit (MB)
-constexpr double kUnknownMemory = 1e300;
-
 constexpr int kJobInit = -1, kJobEnd = -2, kJobAnalyse = 1, kJobFactor = 2, kJobSolve = 3;
 constexpr int kLeanRelaxation = 20;  // ICNTL(14) as MUMPS itself sets it (unsymmetric, one process)
 
@@ -213,19 +210,15 @@ class MumpsSolver final : public LinearSolver {
   // and the kernel's OOM killer end the run when they are touched. Called
   // on every rank alike (collective over the machine's ranks).
   bool does_not_fit(std::string &why) {
-    double need = id_.SP_INFO(15) > 0 ? id_.SP_INFO(15) : 0.0, on_machine = 0;
-    std::string source;
-    const double available = available_memory_mb(&source);
-    double left = available < 0 ? kUnknownMemory : available;
-    MPI_Allreduce(&need, &on_machine, 1, MPI_DOUBLE, MPI_SUM, machine_);
-    MPI_Allreduce(MPI_IN_PLACE, &left, 1, MPI_DOUBLE, MPI_MIN, machine_);
-    if (left >= kUnknownMemory || on_machine <= left) return false;
+    const MachineMemory m =
+        check_machine_memory(machine_, id_.SP_INFO(15) > 0 ? id_.SP_INFO(15) : 0.0);
+    if (m.fits) return false;
     char text[320];
     snprintf(text, sizeof text,
              "MUMPS: its factorisation needs about %.0f MB on this machine (its analysis's "
              "estimate, %d%% workspace relaxation) and %.0f MB are left (%s): out of memory, "
              "not started",
-             on_machine, relaxation_, left, source.empty() ? "the least on its ranks" : source.c_str());
+             m.need_mb, relaxation_, m.left_mb, m.source.c_str());
     why = text;
     out_of_memory_ = true;
     return true;

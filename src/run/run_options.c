@@ -23,14 +23,22 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
   return rc;
 }
 
-void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt) {
+sp_linear_kind sp_linear_auto(int dim, long n_mesh_nodes) {
+  /* MUMPS in 2D; in 3D the cells' blocks (a direct LU of the coupled cells
+   * runs out of memory, docs/3d.md), by MUMPS up to about refinements 3 of
+   * the 3D run 5's ellipsoid and by multigrid from refinements 4, where it
+   * takes the time of the blocks' LU in half their memory and from where
+   * only it fits (docs/solvers.md, "Which solver auto picks") */
+  if (dim != 3) return SP_LINEAR_MUMPS;
+  return n_mesh_nodes >= SP_LINEAR_AUTO_AMG_NODES ? SP_LINEAR_GMRES_AMG : SP_LINEAR_GMRES_CELLS;
+}
+
+void sp_solver_options_from_scene(const sp_scene *scene, long n_mesh_nodes,
+                                  sp_solver_options *opt) {
   static const int jacobian[] = {SP_SOLVER_JAC_AD, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD};
   opt->jacobian = jacobian[scene->solver.jacobian];
-  /* auto: the cells' blocks in 3D, where a direct LU of the coupled
-   * cells runs out of memory, MUMPS in 2D (docs/3d.md, "Solvers in
-   * 3D") */
   opt->linear = scene->solver.linear == SP_LINEAR_AUTO
-                    ? (sp_scene_dim(scene) == 3 ? SP_LINEAR_GMRES_CELLS : SP_LINEAR_MUMPS)
+                    ? (int)sp_linear_auto(sp_scene_dim(scene), n_mesh_nodes)
                     : (int)scene->solver.linear;
   opt->newton_rtol = scene->solver.newton_rtol;
   opt->newton_atol = scene->solver.newton_atol;
@@ -81,7 +89,6 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
   const sp_scene_output *out = &scene->output;
   *opt = (sp_run_options){0};
   sp_model_from_scene(scene, &opt->model);
-  sp_solver_options_from_scene(scene, &opt->solver);
   sp_dt_params_from_scene(scene, &opt->time.dt);
   opt->time.scheme = tc->scheme == SP_TIME_BDF2 ? SP_SCHEME_BDF2 : SP_SCHEME_BE;
   opt->time.adaptive = tc->control == SP_CONTROL_ADAPTIVE;

@@ -88,8 +88,18 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt);
 
 /** @brief The mesh a scene describes. */
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out);
-/** @brief Solver options and model parameters from a scene. */
-void sp_solver_options_from_scene(const sp_scene *scene, sp_solver_options *opt);
+/** @brief The mesh nodes from which `auto` picks gmres_amg in 3D (between
+ *  the 3D run 5's ellipsoid at refinements 3, 4,589 nodes, and 4, 32,597). */
+#define SP_LINEAR_AUTO_AMG_NODES 15000
+/** @brief The solver `solver.linear: auto` picks on a mesh of @p dim and
+ *  @p n_mesh_nodes nodes. */
+sp_linear_kind sp_linear_auto(int dim, long n_mesh_nodes);
+/** @brief Solver options from a scene on a mesh of @p n_mesh_nodes nodes
+ *  (which `auto` depends on); the run's options leave them to the set-up,
+ *  which knows its mesh. */
+void sp_solver_options_from_scene(const sp_scene *scene, long n_mesh_nodes,
+                                  sp_solver_options *opt);
+/** @brief Model parameters from a scene. */
 void sp_model_from_scene(const sp_scene *scene, sp_model_params *model);
 /** @brief The time-step controller's parameters from a scene (dt_control.h). */
 void sp_dt_params_from_scene(const sp_scene *scene, sp_dt_params *params);

@@ -155,6 +155,7 @@ static int initial_run(sp_run *run, const sp_scene *scene, MPI_Comm comm,
   SP_MPI_CALL(MPI_Comm_rank(run->agree_comm, &run->rank));
   SP_MPI_CALL(MPI_Comm_size(run->agree_comm, &run->n_ranks));
   SP_CALL(sp_mesh_from_scene(scene, &run->mesh));
+  sp_solver_options_from_scene(scene, run->mesh->n_nodes, &run->opt.solver);
   /* The initial cells: the scene's disks or a file's (initial.h). A
    * checkpoint's replace them later; a scene without cells (initial.from a
    * checkpoint) has one placeholder cell until then. */

@@ -158,10 +158,10 @@ static int gave_up(const sp_run *run, const sp_step_attempt *a) {
   if (a->verdict == SP_STEP_NEWTON_FAILED && a->report.failure == SP_NEWTON_OUT_OF_MEMORY)
     return sp_error_set(SP_ERR_MEMORY,
                         "step %d at t = %.6g: %s. A smaller step has a matrix of the same size, "
-                        "so it is not retried; solver.linear gmres_amg factors nothing "
-                        "(docs/solvers.md), gmres_cells or gmres_ilu need less memory than a "
-                        "direct solver in 3D, and mumps or superlu_dist on more processes split "
-                        "the factors (docs/3d.md)",
+                        "so it is not retried; per unknown solver.linear gmres_amg needs the "
+                        "least memory (no factorisation), gmres_cells less than mumps or "
+                        "superlu_dist, and processes on more machines split it "
+                        "(docs/solvers.md)",
                         run->step + 1, run->t, a->why);
   return sp_error_set(SP_ERR_SOLVER,
                       "step %d at t = %.6g failed %d attempts "

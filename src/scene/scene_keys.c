@@ -273,8 +273,9 @@ const sp_key sp_keys[] = {
              "(gmres_cells: no fill between cells, docs/3d.md) or with a "
              "Cahn-Hilliard block preconditioner of AMG V-cycles (gmres_amg: "
              "no factorisation, docs/solvers.md); auto: "
-             "gmres_cells on a 3D mesh, mumps on a 2D one (the fastest "
-             "measured in each, docs/3d.md)"),
+             "mumps on a 2D mesh, on a 3D one gmres_cells below 15,000 "
+             "nodes and gmres_amg from there (the fastest measured in "
+             "each, the least memory where they tie, docs/solvers.md)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
               ABOVE(0.0), BELOW(1.0), "-",
               "Newton: residual reduction relative to the first residual (with "
