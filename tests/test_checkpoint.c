@@ -83,7 +83,8 @@ static scene_run *fill_run(const sp_scene *scene) {
   run->dtc = (sp_dt_control){.dt_next = uniform(), .failures = 2, .successes = 3,
                              .ceiling = uniform(), .ceiling_steps = 4, .since_restart = 5,
                              .err_prev = uniform(), .dt_last = uniform(), .rejected_last = 1,
-                             .n_accepted = 6, .n_rejected = 7, .n_newton_failed = 8};
+                             .n_accepted = 6, .n_rejected = 7, .n_newton_failed = 8,
+                             .event_dt = uniform()};
   s->sum = (sp_run_summary){.steps = 17, .failed_attempts = 2, .newton_its = 40,
                             .factorisations = 30, .failed_factorisations = 5, .linear_its = 9,
                             .t_final = 0.0123, .dt_smallest = 1e-6, .wall_seconds = 3.5,

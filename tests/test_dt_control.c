@@ -235,6 +235,11 @@ static void check_restart(void) {
   dt = c.dt_next;
   sp_dt_accepted(&c, dt, 1e-6);
   CHECK_NEAR(c.dt_next, 8.0 * dt, 1e-15 * dt);
+  /* beyond the step wanted before the event no faster than the PI law */
+  CHECK(c.dt_next < c.event_dt, "regrowth %g past the step before %g", c.dt_next, c.event_dt);
+  dt = c.dt_next;
+  sp_dt_accepted(&c, dt, 1e-6);
+  CHECK_NEAR(c.dt_next, SP_DT_GROW_MAX * dt, 1e-15 * dt);
 }
 
 /* A second rejection of a step whose estimate falls more slowly than

@@ -45,7 +45,8 @@ static const sp_member controller_members[] = {
     MEMBER(sp_dt_control, ceiling_steps, 'i'), MEMBER(sp_dt_control, since_restart, 'i'),
     MEMBER(sp_dt_control, err_prev, 'd'),      MEMBER(sp_dt_control, dt_last, 'd'),
     MEMBER(sp_dt_control, rejected_last, 'i'), MEMBER(sp_dt_control, n_accepted, 'l'),
-    MEMBER(sp_dt_control, n_rejected, 'l'),    MEMBER(sp_dt_control, n_newton_failed, 'l')};
+    MEMBER(sp_dt_control, n_rejected, 'l'),    MEMBER(sp_dt_control, n_newton_failed, 'l'),
+    MEMBER(sp_dt_control, event_dt, 'd')};
 
 static const sp_member summary_members[] = {
     MEMBER(sp_run_summary, steps, 'i'),

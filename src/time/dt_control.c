@@ -121,7 +121,9 @@ void sp_dt_accepted(sp_dt_control *c, double dt, double err) {
   }
   double next;
   if (err < 0) next = dt; /* no estimate: hold dt until there is one */
-  else next = dt * (after_event(c) ? event_factor(c, err) : pi_factor(c, err));
+  else if (!after_event(c)) next = dt * pi_factor(c, err);
+  else /* fast back to the step wanted before the event, beyond it the PI law */
+    next = fmin(dt * event_factor(c, err), fmax(c->event_dt, dt * pi_factor(c, err)));
   /* a step shortened to land on an event says nothing against the step
    * the controller wanted: go back to it unless the estimate says shrink */
   if (dt < c->dt_next * (1 - SP_DT_STRETCH) && !(next < dt)) next = fmax(next, c->dt_next);
@@ -149,6 +151,7 @@ void sp_dt_restart(sp_dt_control *c, double dt_first) {
   }
   /* the step before: the one the controller wanted next (a step shortened
    * to land on the division is not the pace of the run) */
+  c->event_dt = c->dt_next;
   if (c->dt_last > 0) dt_first = fmin(dt_first, c->p.event_first * c->dt_next);
   c->dt_next = fmax(fmin(dt_first, c->p.dt_max), c->p.dt_min);
   c->err_prev = 0;

@@ -42,8 +42,9 @@
  *   the step restarts from dt_first (the caller's starting-step estimate
  *   of the post-event state), at most time.event_first of the step before,
  *   and the next time.event_steps steps grow from their estimate alone by
- *   up to time.event_growth (within BDF2's step-ratio limit) before the PI
- *   law takes over again. A rejected step is retried all the same.
+ *   up to time.event_growth (within BDF2's step-ratio limit) back to the
+ *   step wanted before the event, beyond it no faster than the PI law,
+ *   which then takes over again. A rejected step is retried all the same.
  *
  * Both policies land on events (t_end, output times, age divisions in
  * adaptive mode) without a sliver step: a step that would stop short of an
@@ -110,6 +111,8 @@ typedef struct {
                            (-1: none) */
   double err_prev;    /**< adaptive: the last accepted step's estimate (0: none) */
   double dt_last;     /**< the last accepted step (0: none yet) */
+  double event_dt;    /**< adaptive: the step wanted before the last
+                           division (the fast regrowth's goal; 0: none) */
   int rejected_last;  /**< adaptive: the last attempt was rejected */
   double rejected_dt, rejected_err; /**< adaptive: the last rejected attempt of
                                          the step in progress (0: none; so 0
