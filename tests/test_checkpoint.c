@@ -83,7 +83,8 @@ static scene_run *fill_run(const sp_scene *scene) {
   run->dtc = (sp_dt_control){.dt_next = uniform(), .failures = 2, .successes = 3,
                              .ceiling = uniform(), .ceiling_steps = 4, .since_restart = 5,
                              .err_prev = uniform(), .dt_last = uniform(), .rejected_last = 1,
-                             .n_accepted = 6, .n_rejected = 7, .n_newton_failed = 8};
+                             .n_accepted = 6, .n_rejected = 7, .n_newton_failed = 8,
+                             .event_dt = uniform()};
   s->sum = (sp_run_summary){.steps = 17, .failed_attempts = 2, .newton_its = 40,
                             .factorisations = 30, .failed_factorisations = 5, .linear_its = 9,
                             .t_final = 0.0123, .dt_smallest = 1e-6, .wall_seconds = 3.5,
@@ -311,6 +312,7 @@ static void bad_files(const sp_scene *scene) {
   H5LTset_attribute_int(h, "/", "format_version", &v1, 1);
   H5Ldelete(h, "/cells/name", H5P_DEFAULT);
   H5Ldelete(h, "/cells/cut_normal", H5P_DEFAULT);
+  H5Adelete_by_name(h, "/controller", "event_dt", H5P_DEFAULT); /* newer than version 2 */
   H5Fclose(h);
   scene_run *g1, *r1;
   CHECK_OK(restore(good, scene, &g1));
@@ -323,6 +325,9 @@ static void bad_files(const sp_scene *scene) {
     int named = 0;
     for (int k = 0; k < b->cells.n; ++k) named += b->cells.name[k][0] != '\0';
     CHECK(named == 0, "version 1: %d cells named", named);
+    CHECK(a->dtc.event_dt != 0 && b->dtc.event_dt == 0,
+          "without its event_dt attribute: event_dt %g (written %g)", b->dtc.event_dt,
+          a->dtc.event_dt);
   }
   scene_run_free(&g1);
   scene_run_free(&r1);

@@ -12,7 +12,8 @@
 static sp_dt_params adaptive_params(int order) {
   sp_dt_params p = {.policy = SP_DT_ADAPTIVE, .dt = 1e-3, .dt_min = 1e-12, .dt_max = 0.5,
                     .max_retries = 5, .shrink = 0.25, .grow = 2, .grow_after = 3,
-                    .order = order};
+                    .order = order, .event_first = 0.1, .event_growth = 2.4,
+                    .event_steps = 3};
   return p;
 }
 
@@ -193,10 +194,52 @@ static void check_restart(void) {
         "restart: dt %g, err_prev %g, since %d", c.dt_next, c.err_prev, c.since_restart);
   sp_dt_accepted(&c, 2e-8, -1);
   CHECK(c.dt_next == 2e-8, "first step after a restart has no estimate: dt %g", c.dt_next);
-  /* at most a tenth of the last accepted step */
+  /* at most event_first of the step the controller wanted next */
   sp_dt_accepted(&c, 3e-6, 0.5);
+  const double wanted = c.dt_next;
   sp_dt_restart(&c, 1.0);
-  CHECK(c.dt_next == SP_DT_RESTART_FRACTION * 3e-6, "restart after 3e-6: dt %g", c.dt_next);
+  CHECK(c.dt_next == p.event_first * wanted, "restart after 3e-6 (next %g): dt %g", wanted,
+        c.dt_next);
+  /* the event_steps steps after it grow from their estimate alone, up to
+   * event_growth within BDF2's ratio limit (the PI law would give 0.9
+   * 1e-4^(-0.7/3) 0.5^(0.4/3) > 2, capped at 2); no growth after a
+   * rejection; then the PI law again */
+  double dt = c.dt_next;
+  sp_dt_accepted(&c, dt, -1);
+  CHECK(c.dt_next == dt, "no estimate after the event: dt held, %g", c.dt_next);
+  /* ... unless its increment says more: an increment of 30 x the
+   * tolerance (a cut relaxing) gives r^2 / (2r + 1) x 30 = 0.9 */
+  sp_dt_unestimated(&c, dt, 30.0);
+  const double r = 0.03 + sqrt(0.03 * 0.03 + 0.03);
+  CHECK_NEAR(c.dt_next, r * dt, 1e-15 * dt);
+  CHECK_NEAR(r * r / (2 * r + 1) * 30.0, SP_DT_SAFETY, 1e-12);
+  sp_dt_unestimated(&c, dt, 1e-3); /* a small one: the growth cap */
+  CHECK_NEAR(c.dt_next, SP_DT_BDF2_RATIO_MAX * dt, 1e-15 * dt);
+  c.dt_next = dt;
+  sp_dt_accepted(&c, dt, 1e-4);
+  CHECK_NEAR(c.dt_next, fmin(p.event_growth, SP_DT_BDF2_RATIO_MAX) * dt, 1e-15 * dt);
+  dt = c.dt_next;
+  CHECK(sp_dt_judge(&c, dt, 2.0) == SP_DT_REJECT, "err 2 accepted after the event");
+  const double retry = c.dt_next;
+  sp_dt_accepted(&c, retry, 0.5);
+  CHECK(c.dt_next == retry, "growth right after a rejection: %g from %g", c.dt_next, retry);
+  dt = c.dt_next;
+  sp_dt_accepted(&c, dt, 1e-4); /* the 4th step: the PI law, at most 2 */
+  CHECK_NEAR(c.dt_next, SP_DT_GROW_MAX * dt, 1e-15 * dt);
+  /* BE: no ratio limit, event_growth itself */
+  sp_dt_params pb = adaptive_params(1);
+  pb.event_growth = 8.0;
+  sp_dt_init(&c, &pb, 1e-6);
+  sp_dt_accepted(&c, 1e-6, 0.5);
+  sp_dt_restart(&c, 1.0);
+  dt = c.dt_next;
+  sp_dt_accepted(&c, dt, 1e-6);
+  CHECK_NEAR(c.dt_next, 8.0 * dt, 1e-15 * dt);
+  /* beyond the step wanted before the event no faster than the PI law */
+  CHECK(c.dt_next < c.event_dt, "regrowth %g past the step before %g", c.dt_next, c.event_dt);
+  dt = c.dt_next;
+  sp_dt_accepted(&c, dt, 1e-6);
+  CHECK_NEAR(c.dt_next, SP_DT_GROW_MAX * dt, 1e-15 * dt);
 }
 
 /* A second rejection of a step whose estimate falls more slowly than

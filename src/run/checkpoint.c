@@ -38,7 +38,8 @@ typedef struct {
 
 #define MEMBER(strct, m, ty) {#m, offsetof(strct, m), ty}
 
-/** The controller's state (its parameters p come from the scene). */
+/** The controller's state (its parameters p come from the scene; event_dt,
+ *  newer than the format, is an attribute of its own: controller_extra). */
 static const sp_member controller_members[] = {
     MEMBER(sp_dt_control, dt_next, 'd'),       MEMBER(sp_dt_control, failures, 'i'),
     MEMBER(sp_dt_control, successes, 'i'),     MEMBER(sp_dt_control, ceiling, 'd'),
@@ -316,6 +317,7 @@ static int write_state(hid_t f, const sp_run *run) {
   bad |= put_array(f, "/cells/name", H5T_NATIVE_CHAR, run->cells.name, nc * SP_CELL_NAME_MAX);
   bad |= put_array(f, "/cells/cut_normal", H5T_NATIVE_DOUBLE, run->cells.cut_normal, 3 * nc);
   bad |= put_members(f, "/controller", &run->dtc, controller_members, N_OF(controller_members));
+  bad |= H5LTset_attribute_double(f, "/controller", "event_dt", &run->dtc.event_dt, 1) < 0;
   bad |= put_members(f, "/summary", run->mon.sum, summary_members, N_OF(summary_members));
   bad |= put_array(f, "/output/energy_t", H5T_NATIVE_DOUBLE, run->mon.energy_t,
                    run->mon.n_energy);
@@ -811,6 +813,14 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
   /* the controller, the counters, step and time */
   SP_CALL(get_members(ck->file, ck->path, "/controller", &run->dtc, controller_members,
                       N_OF(controller_members)));
+  /* the step wanted before the last division: absent from a checkpoint
+   * written before it existed (0: the regrowth after the next division
+   * knows only its own steps) */
+  run->dtc.event_dt = 0.0;
+  if (H5Aexists_by_name(ck->file, "/controller", "event_dt", H5P_DEFAULT) > 0 &&
+      H5LTget_attribute_double(ck->file, "/controller", "event_dt", &run->dtc.event_dt) < 0)
+    return sp_error_set(SP_ERR_INPUT, "checkpoint '%s': /controller: event_dt unreadable "
+                                      "(damaged?)", ck->path);
   SP_CALL(get_members(ck->file, ck->path, "/summary", run->mon.sum, summary_members,
                       N_OF(summary_members)));
   run->n_max = ck->header[H_N_MAX];

@@ -49,6 +49,24 @@ int sp_events_on_output_time(const sp_run *run, double t) {
   return k > 0 && fabs(t - k * every) <= 1e-12 * run->opt.time.t_end;
 }
 
+/** The starting step after this step's @p n_divided divisions: the
+ *  convexity bound over the daughters' own nodes (c >=
+ *  division.observe_threshold), not the mesh's worst overlap; the
+ *  controller caps it by the step before (sp_dt_restart). */
+static int first_dt_after_divisions(const sp_run *run, int n_divided, double *dt) {
+  const sp_dt_params *p = &run->opt.time.dt;
+  unsigned char *daughters;
+  SP_ALLOC(daughters, (size_t)run->layout->n_cells);
+  for (int i = 0; i < n_divided; ++i)
+    daughters[run->cells.divisions[i].parent] = daughters[run->cells.divisions[i].child] = 1;
+  *dt = fmax(sp_scheme_first_dt_cells(run->layout, run->state, &run->opt.model,
+                                      fmin(p->dt, p->dt_max), daughters,
+                                      run->opt.division.observe_threshold),
+             p->dt_min);
+  free(daughters);
+  return SP_OK;
+}
+
 double sp_events_first_dt(const sp_run *run) {
   const sp_dt_params *p = &run->opt.time.dt;
   const double dt =
@@ -132,46 +150,22 @@ static int layout_with_child(sp_run *run, int parent, sp_layout **out) {
   return sp_layout_with_child(run->layout, parent, out);
 }
 
-/** One division's cut, as a linear map of per-pair values from the run's
- *  layout to the new one (the state's, and the history's increments). */
-typedef struct {
-  const sp_run *run;
-  int parent;
-  const sp_cell_obs *parent_obs;
-  double offset;
-  const sp_layout *new_layout;
-} split_cut;
-
-static int split_values(void *ctx, const double *values, double *new_values) {
-  const split_cut *cut = ctx;
-  const sp_run_division *dv = &cut->run->opt.division;
-  return sp_division_split(cut->run->mesh, cut->run->layout, values, cut->parent,
-                           cut->parent_obs, dv->smooth_cut, dv->interface_width, cut->offset,
-                           cut->new_layout, new_values, cut->new_layout->n_cells - 1);
-}
-
 /** The split state of a division of @p parent on @p new_layout, the child
  *  being its last cell (the division line through the centre, or moved to
  *  halve the mass: division.line; to give the first daughter, the parent's
- *  slot, its share of a lineage entry @p e); under adaptive control the
- *  history's past states are split by the same cut (sp_history_split). */
+ *  slot, its share of a lineage entry @p e). */
 static int split_state(sp_run *run, int parent, const sp_cell_obs *parent_obs,
                        const sp_lineage_entry *e, const sp_layout *new_layout,
                        double *new_state) {
   const sp_run_division *dv = &run->opt.division;
-  split_cut cut = {.run = run, .parent = parent, .parent_obs = parent_obs, .offset = 0.0,
-                   .new_layout = new_layout};
+  double offset = 0.0;
   if (e || dv->equal_mass_line)
     SP_CALL(sp_division_balance_offset(run->mesh, run->layout, run->state, parent, parent_obs,
                                        dv->smooth_cut, dv->interface_width,
-                                       e ? 1.0 - e->fraction : 0.5, &cut.offset));
-  SP_CALL(split_values(&cut, run->state, new_state));
-  if (run->dtc.p.policy != SP_DT_ADAPTIVE) return SP_OK; /* (reset: the paper's restart) */
-  const int rc = sp_history_split(&run->hist, run->mesh, run->layout, run->state, new_layout,
-                                  new_state, parent, new_layout->n_cells - 1, split_values,
-                                  &cut);
-  if (rc != SP_OK) sp_history_reset(&run->hist); /* (the run stops) */
-  return rc;
+                                       e ? 1.0 - e->fraction : 0.5, &offset));
+  return sp_division_split(run->mesh, run->layout, run->state, parent, parent_obs,
+                           dv->smooth_cut, dv->interface_width, offset, new_layout, new_state,
+                           new_layout->n_cells - 1);
 }
 
 /**
@@ -202,9 +196,8 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
     sp_layout_destroy(&new_layout);
     return rc;
   }
-  SP_CALL(sp_run_resize(run, new_layout, new_state,
-                        run->dtc.p.policy == SP_DT_ADAPTIVE ? SP_HISTORY_MOVED
-                                                            : SP_HISTORY_RESET));
+  /* an event: the scheme starts over, no estimate reaches across it */
+  SP_CALL(sp_run_resize(run, new_layout, new_state, SP_HISTORY_RESET));
   sp_registry *cells = &run->cells;
   cells->divided_now[parent] = cells->divided_now[child] = 1;
   cells->source_on[child] = cells->source_on[parent];
@@ -272,8 +265,11 @@ int sp_events_after_step(sp_run *run, double t_old, sp_step_events *ev) {
   if (run->support && !ev->n_divided)
     SP_CALL(sp_support_needs_update(run->support, run->layout, run->state, &outgrown));
   if (run->support && (ev->n_divided || outgrown)) SP_CALL(update_supports(run, ev));
-  if (ev->n_divided) /* algorithm 2, or a new first step */
-    sp_dt_restart(&run->dtc, sp_events_first_dt(run));
+  if (ev->n_divided) { /* algorithm 2, or a restart from the post-event state */
+    double dt_first = 0.0;
+    SP_CALL(first_dt_after_divisions(run, ev->n_divided, &dt_first));
+    sp_dt_restart(&run->dtc, dt_first);
+  }
   if (run->opt.terms.source_rate > 0) {
     sp_registry *cells = &run->cells;
     for (int k = 0; k < run->layout->n_cells; ++k) cells->core_mass[k] = cells->obs[k].mass_core;

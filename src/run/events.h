@@ -42,9 +42,10 @@ typedef struct {
  *         next age division (or a lineage entry's age or time). */
 double sp_events_next(const sp_run *run, double t);
 
-/** @brief The first dt from the run's state (a run's start, after a
- *         division): the convexity bound (sp_scheme_first_dt), at most
- *         time.dt and time.dt_max, at least time.dt_min. */
+/** @brief The first dt of a run from its state: the convexity bound over
+ *         the mesh (sp_scheme_first_dt), at most time.dt and time.dt_max, at
+ *         least time.dt_min. (After a division the bound is taken over the
+ *         daughters' nodes: sp_events_after_step.) */
 double sp_events_first_dt(const sp_run *run);
 
 /** @brief 1 if @p t is a multiple of output.interval (to round-off). */
@@ -66,8 +67,10 @@ int sp_events_landing(sp_run *run, double t, double dt, int *observed, double *t
 
 /** @brief After the accepted step from @p t_old (completed): every cell
  *         whose criterion was crossed divides, the supports follow the
- *         cells, the controller restarts after divisions, the source
- *         switches. Collective. */
+ *         cells, the controller restarts after divisions (an event: the
+ *         history starts over; the first step from the convexity bound
+ *         over the daughters' own nodes), the source switches.
+ *         Collective. */
 int sp_events_after_step(sp_run *run, double t_old, sp_step_events *ev);
 
 #ifdef __cplusplus

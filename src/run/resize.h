@@ -23,12 +23,9 @@ extern "C" {
 typedef enum {
   SP_HISTORY_CARRY, /**< a support change: the past states move with (cell,
                          node) as increments, 0 on new pairs */
-  SP_HISTORY_RESET, /**< the initial layout, a restore (which then reads
-                         its own), a division under the fixed policy: the
-                         scheme starts over */
-  SP_HISTORY_MOVED  /**< the caller has moved the history to the new layout
-                         already (a division under adaptive control:
-                         sp_history_split) */
+  SP_HISTORY_RESET  /**< the initial layout, a restore (which then reads
+                         its own), a division (an event: the scheme starts
+                         over) */
 } sp_history_move;
 
 /**

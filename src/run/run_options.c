@@ -80,7 +80,8 @@ void sp_dt_params_from_scene(const sp_scene *scene, sp_dt_params *p) {
       .max_retries = tc->max_retries, .shrink = tc->shrink, .grow = tc->grow,
       .grow_after = tc->grow_after, .failure_memory = tc->failure_memory,
       .ramp_n_div = scene->division.n_div, .ramp_m = scene->division.m,
-      .order = tc->scheme == SP_TIME_BDF2 ? 2 : 1};
+      .order = tc->scheme == SP_TIME_BDF2 ? 2 : 1, .event_first = tc->event_first,
+      .event_growth = tc->event_growth, .event_steps = tc->event_steps};
 }
 
 void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {

@@ -211,6 +211,11 @@ int sp_step_complete(sp_run *run, const sp_step_attempt *a) {
   run->t = a->t_new;
   ++run->step;
   sp_dt_accepted(&run->dtc, a->dt, a->err);
+  if (o->time.adaptive && a->err < 0) /* the next step from this one's increment */
+    sp_dt_unestimated(&run->dtc, a->dt,
+                      sp_scheme_increment(run->buf.state_old, run->state,
+                                          (size_t)run->layout->n_pairs, o->time.rtol,
+                                          o->time.atol));
   /* the past states: for the scheme, the error estimate, the predictor */
   if (o->time.adaptive || o->time.scheme == SP_SCHEME_BDF2 || o->time.predictor_linear)
     SP_CALL(sp_history_push(&run->hist, run->buf.state_old, a->dt, n_values));

@@ -85,6 +85,10 @@ typedef struct {
   int max_retries;  /**< failed attempts of one step before the run stops */
   int failure_memory; /**< accepted steps after a failure at dt_f during
                            which dt stays <= dt_f / grow (0: none) */
+  double event_first;  /**< adaptive, after a division: the first step's
+                            cap as a fraction of the step before */
+  double event_growth; /**< ... the growth cap of the steps after it */
+  int event_steps;     /**< ... for this many steps, then the PI law */
 } sp_scene_time;
 
 /** One initial cell. */

@@ -246,6 +246,21 @@ const sp_key sp_keys[] = {
             AT_MOST(INT_MAX), "steps",
             "after a failed attempt at dt_f, dt stays <= dt_f / grow for this "
             "many accepted steps (0: it grows back to dt_f after grow_after)"),
+    KEY_FLOAT(SP_SEC_TIME, "event_first", time.event_first, 0.1, ABOVE(0.0),
+              AT_MOST(1.0), "-",
+              "adaptive: the first step after a division is at most this "
+              "fraction of the step the controller wanted next (and at most "
+              "the convexity bound over the daughters' nodes; "
+              "docs/time-stepping.md)"),
+    KEY_FLOAT(SP_SEC_TIME, "event_growth", time.event_growth, 2.4,
+              AT_LEAST(1.0), AT_MOST(10.0), "-",
+              "adaptive: the largest growth of dt a step in the event_steps "
+              "steps after a division, each from its own estimate (bdf2: at "
+              "most 2.4, its step-ratio limit); then the PI law, at most 2"),
+    KEY_INT(SP_SEC_TIME, "event_steps", time.event_steps, 20, AT_LEAST(0),
+            AT_MOST(1000), "steps",
+            "adaptive: how many steps after a division grow by up to "
+            "event_growth from their own estimate before the PI law"),
     /* noise */
     KEY_FLOAT(SP_SEC_NOISE, "background", noise.background, 0.0,
               AT_LEAST(0.0), AT_MOST(1.0), "-",

@@ -58,6 +58,29 @@ static double pi_factor(const sp_dt_control *c, double err) {
   return fmax(f, SP_DT_CUT_MIN);
 }
 
+/** Adaptive: the accepted step is one of the first time.event_steps after
+ *  an event (a division), whose history started over. */
+static int after_event(const sp_dt_control *c) {
+  return c->p.policy == SP_DT_ADAPTIVE && c->since_restart >= 1 &&
+         c->since_restart <= c->p.event_steps;
+}
+
+/** The growth cap of a step just after an event: time.event_growth instead
+ *  of SP_DT_GROW_MAX, within BDF2's step-ratio limit. */
+static double event_cap(const sp_dt_control *c) {
+  return c->p.order >= 2 ? fmin(c->p.event_growth, SP_DT_BDF2_RATIO_MAX) : c->p.event_growth;
+}
+
+/** The growth factor of a step just after an event: the estimate alone (no
+ *  PI memory: the step before the event says nothing about the state after
+ *  it), up to event_cap; no growth right after a rejection, as the PI law. */
+static double event_factor(const sp_dt_control *c, double err) {
+  const double k = c->p.order + 1;
+  const double cap = c->rejected_last ? 1.0 : event_cap(c);
+  const double f = err > 0 ? SP_DT_SAFETY * pow(err, -1.0 / k) : cap;
+  return fmax(fmin(f, cap), SP_DT_CUT_MIN);
+}
+
 sp_dt_verdict sp_dt_judge(sp_dt_control *c, double dt, double err) {
   if (c->p.policy == SP_DT_FIXED || err <= 1) return SP_DT_ACCEPT; /* NaN rejects */
   double k = c->p.order + 1;
@@ -98,7 +121,9 @@ void sp_dt_accepted(sp_dt_control *c, double dt, double err) {
   }
   double next;
   if (err < 0) next = dt; /* no estimate: hold dt until there is one */
-  else next = dt * pi_factor(c, err);
+  else if (!after_event(c)) next = dt * pi_factor(c, err);
+  else /* fast back to the step wanted before the event, beyond it the PI law */
+    next = fmin(dt * event_factor(c, err), fmax(c->event_dt, dt * pi_factor(c, err)));
   /* a step shortened to land on an event says nothing against the step
    * the controller wanted: go back to it unless the estimate says shrink */
   if (dt < c->dt_next * (1 - SP_DT_STRETCH) && !(next < dt)) next = fmax(next, c->dt_next);
@@ -107,13 +132,27 @@ void sp_dt_accepted(sp_dt_control *c, double dt, double err) {
   c->rejected_last = 0;
 }
 
+void sp_dt_unestimated(sp_dt_control *c, double dt, double increment) {
+  if (c->p.policy != SP_DT_ADAPTIVE || !(increment > 0)) return;
+  /* the next step's estimate is BE's, r / (2r + 1) |c - P| with P linear
+   * through this step: if the state then stops changing (a transient that
+   * has relaxed), |c - P| = r x this increment; r such that r^2 / (2r + 1)
+   * x increment = SP_DT_SAFETY */
+  const double a = SP_DT_SAFETY / increment, r = a + sqrt(a * a + a);
+  const double cap = after_event(c) ? event_cap(c) : SP_DT_GROW_MAX;
+  c->dt_next = fmax(fmin(dt * fmin(r, cap), c->p.dt_max), c->p.dt_min);
+}
+
 void sp_dt_restart(sp_dt_control *c, double dt_first) {
   c->since_restart = 0;
   if (c->p.policy == SP_DT_FIXED) {
     c->dt_next = fixed_cap(c); /* algorithm 2's ramp now sets the pace */
     return;
   }
-  if (c->dt_last > 0) dt_first = fmin(dt_first, SP_DT_RESTART_FRACTION * c->dt_last);
+  /* the step before: the one the controller wanted next (a step shortened
+   * to land on the division is not the pace of the run) */
+  c->event_dt = c->dt_next;
+  if (c->dt_last > 0) dt_first = fmin(dt_first, c->p.event_first * c->dt_next);
   c->dt_next = fmax(fmin(dt_first, c->p.dt_max), c->p.dt_min);
   c->err_prev = 0;
   c->rejected_last = 0;

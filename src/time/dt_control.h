@@ -15,6 +15,7 @@
  *                               give_up = sp_dt_give_up(&c);
  *     overshot a mass event:  sp_dt_land(&c, theta * dt);
  *     accepted:               sp_dt_accepted(&c, dt, err);
+ *     ... without estimate:   sp_dt_unestimated(&c, dt, increment);
  *     a cell divided:         sp_dt_restart(&c, dt_first);
  *
  * Two policies (time.control):
@@ -34,10 +35,16 @@
  *   (k = the estimate's order + 1), bounded by SP_DT_GROW_MAX and
  *   SP_DT_CUT_MIN and by [dt_min, dt_max]. The first step has no
  *   estimate: the caller passes dt_first, chosen from the state
- *   (time_scheme.h: sp_scheme_first_dt);
- *   after a division the step restarts from dt_first, at most
- *   SP_DT_RESTART_FRACTION of the last step, and is estimated (the
- *   history is split by the cut: time_scheme.h, sp_history_split).
+ *   (time_scheme.h: sp_scheme_first_dt).
+ *   A division is an event of the integrator: the history starts over
+ *   (the next step is backward Euler, the one after it BDF2 judged by BE's
+ *   estimate: no estimate mixes states from before and after the cut),
+ *   the step restarts from dt_first (the caller's starting-step estimate
+ *   of the post-event state), at most time.event_first of the step before,
+ *   and the next time.event_steps steps grow from their estimate alone by
+ *   up to time.event_growth (within BDF2's step-ratio limit) back to the
+ *   step wanted before the event, beyond it no faster than the PI law,
+ *   which then takes over again. A rejected step is retried all the same.
  *
  * Both policies land on events (t_end, output times, age divisions in
  * adaptive mode) without a sliver step: a step that would stop short of an
@@ -62,9 +69,9 @@ typedef enum { SP_DT_ACCEPT = 0, SP_DT_REJECT = 1 } sp_dt_verdict;
 #define SP_DT_CUT_MIN 0.2
 /** Safety factor of the adaptive controller. */
 #define SP_DT_SAFETY 0.9
-/** Adaptive: the first step after a division (a sharp cut to relax, which
- *  the history does not know) is at most this fraction of the step before. */
-#define SP_DT_RESTART_FRACTION 0.1
+/** Variable-step BDF2 is zero-stable for step ratios below 1 + sqrt(2):
+ *  the largest growth of a BDF2 step after an event (time.event_growth). */
+#define SP_DT_BDF2_RATIO_MAX 2.4
 /** A step may be stretched by this relative amount to land on an event. */
 #define SP_DT_STRETCH 1e-6
 
@@ -84,6 +91,12 @@ typedef struct {
   int ramp_n_div, ramp_m; /**< algorithm 2 after a division (m = 0: none) */
   /* adaptive */
   int order;       /**< order of the error estimate's method (1 BE, 2 BDF2) */
+  double event_first;  /**< after an event: the first step at most this
+                            fraction of the step before */
+  double event_growth; /**< ... and the next event_steps steps grow by up
+                            to this factor (BDF2: at most
+                            SP_DT_BDF2_RATIO_MAX) from their estimate alone */
+  int event_steps;
 } sp_dt_params;
 
 /** The controller's whole state (plain data: a checkpoint can save it). */
@@ -94,9 +107,12 @@ typedef struct {
   int successes;      /**< fixed: accepted steps since dt last grew */
   double ceiling;     /**< fixed: failure memory's cap on dt ... */
   int ceiling_steps;  /**< ... for this many more accepted steps */
-  int since_restart;  /**< accepted steps since the last division (-1: none) */
+  int since_restart;  /**< accepted steps since the last division, an event
+                           (-1: none) */
   double err_prev;    /**< adaptive: the last accepted step's estimate (0: none) */
   double dt_last;     /**< the last accepted step (0: none yet) */
+  double event_dt;    /**< adaptive: the step wanted before the last
+                           division (the fast regrowth's goal; 0: none) */
   int rejected_last;  /**< adaptive: the last attempt was rejected */
   double rejected_dt, rejected_err; /**< adaptive: the last rejected attempt of
                                          the step in progress (0: none; so 0
@@ -136,6 +152,15 @@ int sp_dt_give_up(const sp_dt_control *c);
  *         the next dt. */
 void sp_dt_accepted(sp_dt_control *c, double dt, double err);
 
+/** @brief The accepted step of @p dt had no estimate (the first after a
+ *         start or an event): the next dt from its weighted @p increment
+ *         (time_scheme.h, sp_scheme_increment), so that the next step's
+ *         estimate is on tolerance if the state stops changing (the
+ *         relaxation of a cut that the step has made): r^2 / (2r + 1) x
+ *         increment = SP_DT_SAFETY, r = dt_next / dt, within the growth cap.
+ *         Adaptive only; call after sp_dt_accepted. */
+void sp_dt_unestimated(sp_dt_control *c, double dt, double increment);
+
 /** @brief A step of @p dt_full overshot an event inside it (a cell's mass
  *         passed its division mass): redo it with @p dt, at least dt_min
  *         (not a failure: nothing counts against the step). */
@@ -145,9 +170,10 @@ void sp_dt_land(sp_dt_control *c, double dt);
  *         run's parameters (time.* may differ: t_end, max_steps). */
 void sp_dt_resume(sp_dt_control *c, const sp_dt_params *p);
 
-/** @brief A cell divided: fixed restarts algorithm 2's ramp; adaptive starts
- *         again without an error history from @p dt_first, at most
- *         SP_DT_RESTART_FRACTION of the last accepted step. */
+/** @brief A cell divided (an event): fixed restarts algorithm 2's ramp;
+ *         adaptive starts again without an error history from @p dt_first,
+ *         at most time.event_first of the last accepted step, and lets the
+ *         next time.event_steps steps grow fast. */
 void sp_dt_restart(sp_dt_control *c, double dt_first);
 
 #ifdef __cplusplus

@@ -32,6 +32,9 @@ void sp_history_reset(sp_history *h) { /* the layout may change next: no stale s
   sp_history_free(h);
 }
 
+/** A linear map of per-pair values from one layout to another. */
+typedef int (*sp_history_map)(void *ctx, const double *from_values, double *to_values);
+
 /** sp_history_transfer's map: (cell, node) values, 0 on new pairs. */
 static int transfer_map(void *ctx, const double *from_values, double *to_values) {
   const sp_layout *const *layouts = ctx;
@@ -40,13 +43,10 @@ static int transfer_map(void *ctx, const double *from_values, double *to_values)
 }
 
 /** Move the past states by their increments against the state through
- *  @p map, each cell's increment shifted to its target mass: the mass it
- *  had on @p from, except that the divided @p parent's (child >= 0) is
- *  shared by the daughters in the ratio of their masses in @p state_to. */
+ *  @p map, each cell's increment shifted to the mass it had on @p from. */
 static int history_move(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
                         const double *state_from, const sp_layout *to,
-                        const double *state_to, int parent, int child, sp_history_map map,
-                        void *ctx) {
+                        const double *state_to, sp_history_map map, void *ctx) {
   const size_t n_from = 2 * (size_t)from->n_pairs, n_to = 2 * (size_t)to->n_pairs;
   const int nc = to->n_cells;
   if (h->n == 0) {
@@ -60,15 +60,6 @@ static int history_move(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
   double *mass_to = mass_from + nc, *weight = mass_to + nc;
   int rc = sp_cells_pair_weights(mesh, from, w_from);
   if (rc == SP_OK) rc = sp_cells_pair_weights(mesh, to, w_to);
-  double share = 0.0; /* the child's part of the parent's increment mass */
-  if (rc == SP_OK && child >= 0) {
-    double m_parent = 0.0, m_child = 0.0;
-    for (int p = 0; p < to->n_pairs; ++p) {
-      if (to->pair_cell[p] == parent) m_parent += w_to[p] * state_to[2 * p];
-      if (to->pair_cell[p] == child) m_child += w_to[p] * state_to[2 * p];
-    }
-    share = m_parent + m_child != 0.0 ? m_child / (m_parent + m_child) : 0.5;
-  }
   for (int j = 0; j < 2 && rc == SP_OK; ++j) {
     if (j >= h->n) { /* nothing valid to carry: drop the storage */
       free(h->past[j]);
@@ -92,10 +83,6 @@ static int history_move(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
      * spread evenly over the cell's new support */
     for (int k = 0; k < nc; ++k) mass_from[k] = mass_to[k] = weight[k] = 0.0;
     for (int p = 0; p < from->n_pairs; ++p) mass_from[from->pair_cell[p]] += w_from[p] * inc[2 * p];
-    if (child >= 0) {
-      mass_from[child] = share * mass_from[parent];
-      mass_from[parent] -= mass_from[child];
-    }
     for (int p = 0; p < to->n_pairs; ++p) {
       mass_to[to->pair_cell[p]] += w_to[p] * past[2 * p];
       weight[to->pair_cell[p]] += w_to[p];
@@ -115,14 +102,7 @@ int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
                         const double *state_from, const sp_layout *to,
                         const double *state_to) {
   const sp_layout *layouts[2] = {from, to};
-  return history_move(h, mesh, from, state_from, to, state_to, -1, -1, transfer_map,
-                      (void *)layouts);
-}
-
-int sp_history_split(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
-                     const double *state_from, const sp_layout *to, const double *state_to,
-                     int parent, int child, sp_history_map split, void *ctx) {
-  return history_move(h, mesh, from, state_from, to, state_to, parent, child, split, ctx);
+  return history_move(h, mesh, from, state_from, to, state_to, transfer_map, (void *)layouts);
 }
 
 sp_scheme_kind sp_scheme_of_step(sp_scheme_kind scheme, const sp_history *h) {
@@ -130,7 +110,8 @@ sp_scheme_kind sp_scheme_of_step(sp_scheme_kind scheme, const sp_history *h) {
 }
 
 int sp_scheme_has_estimate(sp_scheme_kind kind, const sp_history *h) {
-  return h->n >= (kind == SP_SCHEME_BDF2 ? 2 : 1);
+  (void)kind; /* BDF2 with one past state: BE's estimate, a bound */
+  return h->n >= 1;
 }
 
 void sp_scheme_be_form(sp_scheme_kind kind, const sp_history *h, double dt,
@@ -169,15 +150,16 @@ double sp_scheme_error(sp_scheme_kind kind, const sp_history *h, double dt,
                        double rtol, double atol, double *scratch) {
   if (!sp_scheme_has_estimate(kind, h)) return -1.0;
   const double h0 = dt, h1 = h->dt[0];
+  const int quadratic = kind == SP_SCHEME_BDF2 && h->n >= 2;
   double factor;
-  if (kind == SP_SCHEME_BDF2) {
+  if (quadratic) {
     const double h2 = h->dt[1];
     factor = h0 * (h0 + h1) /
              (3 * h0 * h0 + 4 * h0 * h1 + 2 * h0 * h2 + h1 * h1 + h1 * h2);
   } else {
     factor = h0 / (2 * h0 + h1);
   }
-  sp_scheme_extrapolate(kind == SP_SCHEME_BDF2 ? 2 : 1, h, dt, state, n_pairs, scratch);
+  sp_scheme_extrapolate(quadratic ? 2 : 1, h, dt, state, n_pairs, scratch);
   double err = 0.0;
   for (size_t p = 0; p < n_pairs; ++p) {
     const double c = state_new[2 * p];
@@ -189,17 +171,32 @@ double sp_scheme_error(sp_scheme_kind kind, const sp_history *h, double dt,
   return err;
 }
 
-double sp_scheme_first_dt(const sp_layout *layout, const double *state,
-                          const sp_model_params *model, double dt_cap) {
+double sp_scheme_increment(const double *state, const double *state_new, size_t n_pairs,
+                           double rtol, double atol) {
+  double norm = 0.0;
+  for (size_t p = 0; p < n_pairs; ++p) {
+    const double c = state_new[2 * p];
+    const double scale = atol + rtol * fmax(fabs(state[2 * p]), fabs(c));
+    norm = fmax(norm, fabs(c - state[2 * p]) / scale);
+  }
+  return norm;
+}
+
+double sp_scheme_first_dt_cells(const sp_layout *layout, const double *state,
+                                const sp_model_params *model, double dt_cap,
+                                const unsigned char *cells, double threshold) {
   const double alpha = model->alpha, lambda = model->lambda;
   double curvature = 0.0; /* the largest negative curvature L over the nodes */
   for (int i = 0; i < layout->n_nodes; ++i) {
     const int p0 = layout->node_start[i], p1 = layout->node_start[i + 1];
     double sum_sq = 0.0, sum_abs = 0.0;
+    int counted = !cells; /* a node of one of @p cells */
     for (int p = p0; p < p1; ++p) {
       sum_sq += state[2 * p] * state[2 * p];
       sum_abs += fabs(state[2 * p]);
+      if (cells && cells[layout->pair_cell[p]] && state[2 * p] >= threshold) counted = 1;
     }
+    if (!counted) continue;
     for (int p = p0; p < p1; ++p) { /* Gershgorin: row k of the Hessian */
       const double c = state[2 * p];
       const double diag = 2 * alpha * (6 * c * c - 6 * c + 1) + 2 * lambda * (sum_sq - c * c);
@@ -211,4 +208,9 @@ double sp_scheme_first_dt(const sp_layout *layout, const double *state,
   const double dt = SP_SCHEME_FIRST_SAFETY * 4 * model->kappa /
                     (model->mobility * curvature * curvature);
   return fmin(dt, dt_cap);
+}
+
+double sp_scheme_first_dt(const sp_layout *layout, const double *state,
+                          const sp_model_params *model, double dt_cap) {
+  return sp_scheme_first_dt_cells(layout, state, model, dt_cap, NULL, 0.0);
 }

@@ -24,6 +24,9 @@
  *   BE   (P linear through c^{n-1}, c^n):   e = h / (2h + h1) (c - P)
  *   BDF2 (P quadratic through c^{n-2..n}): e = h (h + h1) /
  *        (3h^2 + 4h h1 + 2h h2 + h1^2 + h1 h2) (c - P)      (2/11 for equal steps)
+ *   BDF2 with one past state (the second step after a start or an event):
+ *        BE's estimate, which bounds the second-order step's error, so
+ *        that step is judged too.
  * weighed as max_i |e_i| / (atol + rtol max(|c^n_i|, |c_i|)) over the c
  * unknowns of every cell: 1 is on tolerance. A max norm, not an RMS, so the
  * tolerance means the same with full and local supports.
@@ -54,7 +57,7 @@ typedef enum { SP_SCHEME_BE = 0, SP_SCHEME_BDF2 = 1 } sp_scheme_kind;
  * The past states a step needs, on the current layout (2 values per pair,
  * as the state): past[0] at t^{n-1}, past[1] at t^{n-2}; dt[0] = t^n -
  * t^{n-1}, dt[1] = t^{n-1} - t^{n-2}. n: how many are valid (0 after the
- * start and after a division).
+ * start and after a division: an event starts the scheme over).
  */
 typedef struct {
   int n;
@@ -66,7 +69,8 @@ typedef struct {
  *         state_old becomes past[0] (n_values values copied). */
 int sp_history_push(sp_history *h, const double *state_old, double dt, size_t n_values);
 
-/** @brief Forget the past (after a division): the next step is BE. */
+/** @brief Forget the past (after a division, an event): the next step is
+ *         BE, and no estimate mixes states from before and after it. */
 void sp_history_reset(sp_history *h);
 
 void sp_history_free(sp_history *h);
@@ -84,30 +88,11 @@ int sp_history_transfer(sp_history *h, const sp_mesh *mesh, const sp_layout *fro
                         const double *state_from, const sp_layout *to,
                         const double *state_to);
 
-/** A linear map of per-pair values from one layout to another (the
- *  division's split of the parent: sp_history_split). */
-typedef int (*sp_history_map)(void *ctx, const double *from_values, double *to_values);
-
-/**
- * @brief Carry the past states through a division: the increments against
- *        the state are split as the state was (@p split: the same cut, a
- *        linear map from the old layout to @p to, whose cell @p child is
- *        new and whose @p parent was the divided cell), then every cell's
- *        increment is shifted to the mass it had (the parent's shared by
- *        the daughters in the ratio of their masses in @p state_to; 0 with
- *        s = 0), as sp_history_transfer does. BDF2 and its error estimate
- *        go on through the cut instead of starting over: the estimate of
- *        the first step after it measures the cut's relaxation.
- */
-int sp_history_split(sp_history *h, const sp_mesh *mesh, const sp_layout *from,
-                     const double *state_from, const sp_layout *to, const double *state_to,
-                     int parent, int child, sp_history_map split, void *ctx);
-
 /** @brief The scheme a step takes: BDF2 needs one past state, else BE. */
 sp_scheme_kind sp_scheme_of_step(sp_scheme_kind scheme, const sp_history *h);
 
-/** @brief 1 if the step of this kind has an error estimate (BE: one past
- *         state; BDF2: two). */
+/** @brief 1 if the step of this kind has an error estimate: one past state
+ *         (BDF2 with one is judged by BE's estimate, with two by its own). */
 int sp_scheme_has_estimate(sp_scheme_kind kind, const sp_history *h);
 
 /**
@@ -133,6 +118,15 @@ double sp_scheme_error(sp_scheme_kind kind, const sp_history *h, double dt,
                        double rtol, double atol, double *scratch);
 
 /**
+ * @brief The weighted max-norm of a step's increment of c, max_i |c_i -
+ *        c^n_i| / (atol + rtol max(|c^n_i|, |c_i|)) (the estimate's
+ *        weights): what a step without an estimate tells the next one
+ *        (dt_control.h, sp_dt_unestimated).
+ */
+double sp_scheme_increment(const double *state, const double *state_new, size_t n_pairs,
+                           double rtol, double atol);
+
+/**
  * @brief A first step small enough that the backward-Euler step is a convex
  *        problem from @p state: the step minimises Pi + |c - c^n|^2_{H^-1} /
  *        (2 M dt), which is convex when dt < 4 kappa / (M L^2), L the
@@ -143,6 +137,15 @@ double sp_scheme_error(sp_scheme_kind kind, const sp_history *h, double dt,
  */
 double sp_scheme_first_dt(const sp_layout *layout, const double *state,
                           const sp_model_params *model, double dt_cap);
+
+/**
+ * @brief The same bound over the nodes where one of @p cells (a flag per
+ *        cell; NULL: every node) has c >= @p threshold: the post-event
+ *        step of the cells an event changed, not the mesh's worst overlap.
+ */
+double sp_scheme_first_dt_cells(const sp_layout *layout, const double *state,
+                                const sp_model_params *model, double dt_cap,
+                                const unsigned char *cells, double threshold);
 
 #ifdef __cplusplus
 }
