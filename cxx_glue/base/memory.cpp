@@ -79,7 +79,7 @@ double available_memory_mb(std::string *source) {
   return best < 0 ? -1 : best / 1048576.0;
 }
 
-MachineMemory check_machine_memory(MPI_Comm machine, double need_mb) {
+MachineMemory check_machine_memory(MPI_Comm all, MPI_Comm machine, double need_mb) {
   constexpr double kUnknown = 1e300;  // no limit known
   MachineMemory m;
   const double available = available_memory_mb(&m.source);
@@ -87,7 +87,10 @@ MachineMemory check_machine_memory(MPI_Comm machine, double need_mb) {
   MPI_Allreduce(&need, &m.need_mb, 1, MPI_DOUBLE, MPI_SUM, machine);
   MPI_Allreduce(MPI_IN_PLACE, &left, 1, MPI_DOUBLE, MPI_MIN, machine);
   m.left_mb = left;
-  m.fits = left >= kUnknown || m.need_mb <= left;
+  m.fits_here = left >= kUnknown || m.need_mb <= left;
+  int everywhere = m.fits_here;
+  MPI_Allreduce(MPI_IN_PLACE, &everywhere, 1, MPI_INT, MPI_MIN, all);
+  m.fits = everywhere;
   if (m.source.empty()) m.source = "the least on its ranks";
   return m;
 }

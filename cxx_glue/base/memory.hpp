@@ -19,14 +19,17 @@ double available_memory_mb(std::string *source);
 
 // A solver's estimate of what it is about to allocate, checked against what
 // the machine still offers: need_mb (this rank's) summed over the ranks of
-// @p machine (those on one machine: MPI_Comm_split_type SHARED), against
-// the least any of them may still use. Collective over machine.
+// @p machine (those on one machine: MPI_Comm_split_type SHARED of @p all),
+// against the least any of them may still use; and whether it fits on
+// every machine of @p all, so that all ranks go on or stop together.
+// Collective over all.
 struct MachineMemory {
-  bool fits = true;      // also when no limit can be read
-  double need_mb = 0;    // summed over the machine's ranks
-  double left_mb = 0;    // the least left on any of them
-  std::string source;    // what bounds it (available_memory_mb's source)
+  bool fits = true;       // on every machine (also when no limit can be read)
+  bool fits_here = true;  // on this rank's machine
+  double need_mb = 0;     // summed over this machine's ranks
+  double left_mb = 0;     // the least left on any of them
+  std::string source;     // what bounds it (available_memory_mb's source)
 };
-MachineMemory check_machine_memory(MPI_Comm machine, double need_mb);
+MachineMemory check_machine_memory(MPI_Comm all, MPI_Comm machine, double need_mb);
 
 }  // namespace sp

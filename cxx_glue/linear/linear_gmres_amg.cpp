@@ -314,14 +314,19 @@ class AmgBlockSolver final : public LinearSolver {
   // offers (memory.hpp); if so why says what it needs and what is left.
   // Collective over the machine's ranks.
   bool does_not_fit(const CsrRows &A, std::string &why) {
-    const MachineMemory m = check_machine_memory(machine_, estimate_mb(A));
+    const MachineMemory m = check_machine_memory(mpi_, machine_, estimate_mb(A));
     if (m.fits) return false;
     char text[320];
-    snprintf(text, sizeof text,
-             "GMRES with the CH block preconditioner: its matrices, multigrid hierarchies and "
-             "Krylov basis need about %.0f MB on this machine and %.0f MB are left (%s): out of "
-             "memory, not started",
-             m.need_mb, m.left_mb, m.source.c_str());
+    if (m.fits_here)
+      snprintf(text, sizeof text,
+               "GMRES with the CH block preconditioner: its set-up does not fit on another "
+               "machine of the run: out of memory, not started");
+    else
+      snprintf(text, sizeof text,
+               "GMRES with the CH block preconditioner: its matrices, multigrid hierarchies and "
+               "Krylov basis need about %.0f MB on this machine and %.0f MB are left (%s): out "
+               "of memory, not started",
+               m.need_mb, m.left_mb, m.source.c_str());
     why = text;
     out_of_memory_ = true;
     return true;

@@ -211,14 +211,20 @@ class MumpsSolver final : public LinearSolver {
   // on every rank alike (collective over the machine's ranks).
   bool does_not_fit(std::string &why) {
     const MachineMemory m =
-        check_machine_memory(machine_, id_.SP_INFO(15) > 0 ? id_.SP_INFO(15) : 0.0);
+        check_machine_memory(comm_, machine_, id_.SP_INFO(15) > 0 ? id_.SP_INFO(15) : 0.0);
     if (m.fits) return false;
     char text[320];
-    snprintf(text, sizeof text,
-             "MUMPS: its factorisation needs about %.0f MB on this machine (its analysis's "
-             "estimate, %d%% workspace relaxation) and %.0f MB are left (%s): out of memory, "
-             "not started",
-             m.need_mb, relaxation_, m.left_mb, m.source.c_str());
+    if (m.fits_here)
+      snprintf(text, sizeof text,
+               "MUMPS: its factorisation does not fit on another machine of the run (%d%% "
+               "workspace relaxation): out of memory, not started",
+               relaxation_);
+    else
+      snprintf(text, sizeof text,
+               "MUMPS: its factorisation needs about %.0f MB on this machine (its analysis's "
+               "estimate, %d%% workspace relaxation) and %.0f MB are left (%s): out of memory, "
+               "not started",
+               m.need_mb, relaxation_, m.left_mb, m.source.c_str());
     why = text;
     out_of_memory_ = true;
     return true;
