@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The linear solvers side by side: MUMPS (the 2D default), gmres_cells
-# (GMRES on the cells' blocks factored by MUMPS, the 3D default) and
-# gmres_amg (GMRES with the Cahn-Hilliard block preconditioner of AMG
-# V-cycles, no factorisation), each case run once per solver and process
+# (GMRES on the cells' blocks factored by MUMPS, the 3D default below
+# 15,000 mesh nodes) and gmres_amg (GMRES with the Cahn-Hilliard block
+# preconditioner of AMG V-cycles, no factorisation, the 3D default from
+# there), each case run once per solver and process
 # count, one run at a time, every run the same fixed steps (backward
 # Euler at a fixed dt, no growth of dt) so that they solve the same
 # systems. Per run: the largest unknowns, the Newton iterations, the GMRES

@@ -312,7 +312,7 @@ class AmgBlockSolver final : public LinearSolver {
 
   // Whether the set-up for A would not fit in the memory the machine still
   // offers (memory.hpp); if so why says what it needs and what is left.
-  // Collective over the machine's ranks.
+  // Collective over the solver's ranks: all go on or stop together.
   bool does_not_fit(const CsrRows &A, std::string &why) {
     const MachineMemory m = check_machine_memory(mpi_, machine_, estimate_mb(A));
     if (m.fits) return false;

@@ -208,7 +208,8 @@ class MumpsSolver final : public LinearSolver {
   // is not started (out_of_memory(), why says what it needs and what is
   // left): on a machine that overcommits, its allocations would succeed
   // and the kernel's OOM killer end the run when they are touched. Called
-  // on every rank alike (collective over the machine's ranks).
+  // on every rank alike (collective over the solver's ranks: where one machine
+  // does not fit, every rank stops).
   bool does_not_fit(std::string &why) {
     const MachineMemory m =
         check_machine_memory(comm_, machine_, id_.SP_INFO(15) > 0 ? id_.SP_INFO(15) : 0.0);
