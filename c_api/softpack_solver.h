@@ -221,6 +221,16 @@ int sp_solver_create(MPI_Comm comm, const sp_solver_options *options,
 /** @brief The number of ranks of the solver's communicator (0 on error). */
 int sp_solver_ranks(sp_solver s);
 
+/**
+ * @brief Take another linear solver (@p linear, sp_linear_kind, not auto)
+ *        with @p krylov_tol for its solves from the next
+ *        sp_solver_set_problem on, which then rebuilds everything, as for
+ *        a new layout. Collective; between steps only.
+ * @return SP_SOLVER_OK, SP_SOLVER_ERR_INPUT for a solver this run cannot
+ *         take (as sp_solver_create), or another class.
+ */
+int sp_solver_set_linear(sp_solver s, int linear, double krylov_tol);
+
 /** @brief (Re)build maps, graph and matrix for a mesh and layout. Cheap to
  *         call again with the same layout; a new layout rebuilds everything. */
 int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh,

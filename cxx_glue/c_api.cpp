@@ -88,6 +88,14 @@ int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh, const sp_layout
   });
 }
 
+int sp_solver_set_linear(sp_solver s, int linear, double krylov_tol) {
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
+  return guarded(s, [&] {
+    need(s->impl != nullptr, "the solver was not created");
+    s->impl->set_linear(linear, krylov_tol);
+  });
+}
+
 int sp_solver_carry_point(sp_solver s, int *carry, double *dt, const double **x,
                           const sp_shape_coef **shape, int *n_shape, int *shape_implicit) {
   if (!s) return SP_SOLVER_ERR_INTERNAL;

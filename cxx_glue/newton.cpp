@@ -461,6 +461,16 @@ void Solver::build_nox_solve() {
   n.solver = NOX::Solver::buildSolver(n.group, n.tests, n.params);
 }
 
+void Solver::set_linear(int linear, double krylov_tol) {
+  sp_solver_options options = options_;
+  options.linear = linear;
+  options.krylov_tol = krylov_tol;
+  std::unique_ptr<LinearSolver> direct = make_linear_solver(comm_, options);
+  linear_ = std::make_unique<LowRankSolver>(comm_, std::move(direct));
+  options_ = options;
+  assembly_.reset();  // the next set_problem builds all for the new solver
+}
+
 void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout) {
   if (assembly_ && assembly_->same_layout(layout)) return;
   assembly_.reset(new Assembly(comm_, mesh, layout));

@@ -32,6 +32,8 @@ class Solver {
   Solver &operator=(const Solver &) = delete;
 
   void set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout);
+  // Another linear solver from the next set_problem on (which rebuilds).
+  void set_linear(int linear, double krylov_tol);
   /// Whether the next step may begin on the current factorisation
   /// (jacobian_carry), and the point its Jacobian was filled at: dt, the
   /// full state, the step's shape coefficients (for a checkpoint).

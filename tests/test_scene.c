@@ -98,6 +98,7 @@ static void test_defaults(void) {
   CHECK(s->noise.seed == 1u, "seed %u", s->noise.seed);
   CHECK(s->solver.jacobian == SP_JAC_AD, "jacobian %d", s->solver.jacobian);
   CHECK(s->solver.linear == SP_LINEAR_AUTO, "linear %d", s->solver.linear);
+  CHECK(s->solver.auto_unknowns == 250000, "auto_unknowns %d", s->solver.auto_unknowns);
   CHECK_NEAR(s->solver.krylov_tol, 0.0, 0.0);
   CHECK(s->solver.predictor == SP_PREDICT_LINEAR, "predictor %d", s->solver.predictor);
   CHECK_NEAR(s->solver.jacobian_reuse, 0.1, 0.0);
@@ -187,16 +188,26 @@ static void test_every_key(void) {
   sp_scene_destroy(&s);
 }
 
-/* solver.linear auto: mumps on a 2D mesh, gmres_cells on a 3D one below
- * SP_LINEAR_AUTO_AMG_NODES nodes and gmres_amg from there; krylov_tol 0:
- * 1e-10 for gmres_ilu, 1e-4 for gmres_cells, 1e-6 for gmres_amg, else as
- * given */
+/* solver.linear auto: on a 2D mesh mumps below solver.auto_unknowns
+ * unknowns (default 250,000) and gmres_cells from there, on a 3D one
+ * gmres_cells below SP_LINEAR_AUTO_AMG_NODES nodes and gmres_amg from
+ * there, whatever the unknowns; krylov_tol 0: 1e-10 for gmres_ilu, 1e-4
+ * for gmres_cells, 1e-6 for gmres_amg, else as given */
 static void test_linear_auto(void) {
-  CHECK(sp_linear_auto(2, 10000000) == SP_LINEAR_MUMPS, "auto in 2D on 1e7 nodes: mumps");
-  CHECK(sp_linear_auto(3, SP_LINEAR_AUTO_AMG_NODES - 1) == SP_LINEAR_GMRES_CELLS,
+  CHECK(sp_linear_auto(2, 10000000, 249999, 250000) == SP_LINEAR_MUMPS,
+        "auto in 2D on 1e7 nodes, 249,999 unknowns: mumps");
+  CHECK(sp_linear_auto(2, 1000, 250000, 250000) == SP_LINEAR_GMRES_CELLS,
+        "auto in 2D from solver.auto_unknowns: gmres_cells");
+  CHECK(sp_linear_auto(3, SP_LINEAR_AUTO_AMG_NODES - 1, 100000000, 250000) ==
+            SP_LINEAR_GMRES_CELLS,
         "auto in 3D below the crossover: gmres_cells");
-  CHECK(sp_linear_auto(3, SP_LINEAR_AUTO_AMG_NODES) == SP_LINEAR_GMRES_AMG,
+  CHECK(sp_linear_auto(3, SP_LINEAR_AUTO_AMG_NODES, 0, 250000) == SP_LINEAR_GMRES_AMG,
         "auto in 3D from the crossover: gmres_amg");
+  CHECK(sp_krylov_tol(SP_LINEAR_GMRES_CELLS, 0) == 1e-4 &&
+            sp_krylov_tol(SP_LINEAR_GMRES_AMG, 0) == 1e-6 &&
+            sp_krylov_tol(SP_LINEAR_MUMPS, 0) == 1e-10 &&
+            sp_krylov_tol(SP_LINEAR_GMRES_CELLS, 3e-5) == 3e-5,
+        "krylov_tol: the solver's own for 0, else as given");
   const struct {
     const char *scene, *set[2];
     int linear;

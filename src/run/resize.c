@@ -1,5 +1,6 @@
 #include "run/resize.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "base/agree.h"
@@ -56,6 +57,25 @@ static int alloc_step_buffers(sp_run *run) {
   return SP_OK;
 }
 
+/** solver.linear auto: the solver for the run's layout (in 2D it depends on
+ *  the unknowns); a change takes effect at the attach that follows. */
+static int pick_linear(sp_run *run) {
+  const sp_run_linear_auto *a = &run->opt.linear_auto;
+  if (!a->on) return SP_OK;
+  const long unknowns = 2L * run->layout->n_pairs;
+  const int linear = (int)sp_linear_auto(run->mesh->dim, run->mesh->n_nodes, unknowns, a->unknowns);
+  if (linear == run->opt.solver.linear) return SP_OK;
+  const double tol = sp_krylov_tol(linear, a->krylov_tol);
+  const int status = sp_solver_set_linear(run->solver, linear, tol);
+  if (status != SP_SOLVER_OK) return sp_solver_failed(run->solver, status, "solver.linear auto");
+  if (run->rank == 0)
+    printf("softpack: solver.linear auto: %s from here (%ld unknowns, solver.auto_unknowns %ld)\n",
+           sp_scene_linear_name((sp_linear_kind)linear), unknowns, a->unknowns);
+  run->opt.solver.linear = linear;
+  run->opt.solver.krylov_tol = tol;
+  return SP_OK;
+}
+
 int sp_run_resize(sp_run *run, sp_layout *layout, double *state, sp_history_move how) {
   if (how == SP_HISTORY_CARRY && run->layout) {
     const int rc =
@@ -75,5 +95,6 @@ int sp_run_resize(sp_run *run, sp_layout *layout, double *state, sp_history_move
   SP_CALL(alloc_step_buffers(run));
   SP_CALL(sp_registry_resize(&run->cells, layout->n_cells));
   SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* attaching is collective */
+  SP_CALL(pick_linear(run));
   return sp_solver_attach(run->solver, run->mesh, run->layout);
 }

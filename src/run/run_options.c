@@ -23,14 +23,29 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out) {
   return rc;
 }
 
-sp_linear_kind sp_linear_auto(int dim, long n_mesh_nodes) {
-  /* MUMPS in 2D; in 3D the cells' blocks (a direct LU of the coupled cells
-   * runs out of memory, docs/3d.md), by MUMPS up to about refinements 3 of
-   * the 3D run 5's ellipsoid and by multigrid from refinements 4, where it
-   * takes the time of the blocks' LU in half their memory and from where
-   * only it fits (docs/solvers.md, "Which solver auto picks") */
-  if (dim != 3) return SP_LINEAR_MUMPS;
+sp_linear_kind sp_linear_auto(int dim, long n_mesh_nodes, long n_unknowns, long auto_unknowns) {
+  /* In 2D MUMPS, and past a few hundred thousand unknowns GMRES on the
+   * cells' blocks, faster in less memory; in 3D the cells' blocks (a
+   * direct LU of the coupled cells runs out of memory, docs/3d.md), by
+   * MUMPS up to about refinements 3 of the 3D run 5's ellipsoid and by
+   * multigrid from refinements 4, where it takes the time of the blocks'
+   * LU in half their memory and from where only it fits (docs/solvers.md,
+   * "Which solver auto picks") */
+  if (dim != 3) return n_unknowns >= auto_unknowns ? SP_LINEAR_GMRES_CELLS : SP_LINEAR_MUMPS;
   return n_mesh_nodes >= SP_LINEAR_AUTO_AMG_NODES ? SP_LINEAR_GMRES_AMG : SP_LINEAR_GMRES_CELLS;
+}
+
+double sp_krylov_tol(int linear, double given) {
+  /* GMRES on the cells' blocks keeps each cell's mass at any tolerance
+   * (cxx_glue/linear/linear_gmres_cells.cpp), and 1e-4 changes the 3D
+   * run 5 by 1e-8 (docs/3d.md); gmres_amg restores each cell's mass after
+   * each solve, and at 1e-4 its Newton takes more iterations than with
+   * exact solves, at 1e-6 the same (docs/solvers.md); ILU's keeps no
+   * mass, hence its 1e-10 */
+  return given > 0                           ? given
+         : linear == SP_LINEAR_GMRES_CELLS ? 1e-4
+         : linear == SP_LINEAR_GMRES_AMG   ? 1e-6
+                                           : 1e-10;
 }
 
 void sp_solver_options_from_scene(const sp_scene *scene, long n_mesh_nodes,
@@ -38,22 +53,14 @@ void sp_solver_options_from_scene(const sp_scene *scene, long n_mesh_nodes,
   static const int jacobian[] = {SP_SOLVER_JAC_AD, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_FD};
   opt->jacobian = jacobian[scene->solver.jacobian];
   opt->linear = scene->solver.linear == SP_LINEAR_AUTO
-                    ? (int)sp_linear_auto(sp_scene_dim(scene), n_mesh_nodes)
+                    ? (int)sp_linear_auto(sp_scene_dim(scene), n_mesh_nodes, 0,
+                                          scene->solver.auto_unknowns)
                     : (int)scene->solver.linear;
   opt->newton_rtol = scene->solver.newton_rtol;
   opt->newton_atol = scene->solver.newton_atol;
   opt->newton_max_its = scene->solver.newton_max_its;
   opt->ilu_fill = scene->solver.ilu_fill;
-  /* 0: the solver's own tolerance. GMRES on the cells' blocks keeps each
-   * cell's mass at any tolerance (cxx_glue/linear/linear_gmres_cells.cpp),
-   * and 1e-4 changes the 3D run 5 by 1e-8 (docs/3d.md); gmres_amg restores
-   * each cell's mass after each solve, and at 1e-4 its Newton takes more
-   * iterations than with exact solves, at 1e-6 the same (docs/solvers.md);
-   * ILU's keeps no mass, hence its 1e-10 */
-  opt->krylov_tol = scene->solver.krylov_tol > 0             ? scene->solver.krylov_tol
-                    : opt->linear == SP_LINEAR_GMRES_CELLS ? 1e-4
-                    : opt->linear == SP_LINEAR_GMRES_AMG   ? 1e-6
-                                                           : 1e-10;
+  opt->krylov_tol = sp_krylov_tol(opt->linear, scene->solver.krylov_tol);
   opt->jacobian_reuse = scene->solver.jacobian_reuse;
   opt->jacobian_carry = scene->solver.jacobian_carry;
   opt->newton_divergence = scene->solver.newton_divergence;
@@ -90,6 +97,9 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
   const sp_scene_output *out = &scene->output;
   *opt = (sp_run_options){0};
   sp_model_from_scene(scene, &opt->model);
+  opt->linear_auto = (sp_run_linear_auto){.on = scene->solver.linear == SP_LINEAR_AUTO,
+                                          .unknowns = scene->solver.auto_unknowns,
+                                          .krylov_tol = scene->solver.krylov_tol};
   sp_dt_params_from_scene(scene, &opt->time.dt);
   opt->time.scheme = tc->scheme == SP_TIME_BDF2 ? SP_SCHEME_BDF2 : SP_SCHEME_BE;
   opt->time.adaptive = tc->control == SP_CONTROL_ADAPTIVE;

@@ -73,10 +73,18 @@ typedef struct {
   sp_output_units units;   /**< units.csv (output.length_unit, ...) */
 } sp_run_output;
 
+/** solver.linear: auto, decided again at each layout (sp_linear_auto). */
+typedef struct {
+  int on;            /**< the scene says auto */
+  long unknowns;     /**< solver.auto_unknowns */
+  double krylov_tol; /**< the scene's solver.krylov_tol (0: the solver's own) */
+} sp_run_linear_auto;
+
 /** Everything a run reads of its scene after set-up. */
 typedef struct {
   sp_model_params model;
   sp_solver_options solver;
+  sp_run_linear_auto linear_auto;
   sp_run_time time;
   sp_run_division division;
   sp_run_terms terms;
@@ -92,11 +100,17 @@ int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out);
  *  the 3D run 5's ellipsoid at refinements 3, 4,589 nodes, and 4, 32,597). */
 #define SP_LINEAR_AUTO_AMG_NODES 15000
 /** @brief The solver `solver.linear: auto` picks on a mesh of @p dim and
- *  @p n_mesh_nodes nodes. */
-sp_linear_kind sp_linear_auto(int dim, long n_mesh_nodes);
+ *  @p n_mesh_nodes nodes for a layout of @p n_unknowns unknowns: in 2D
+ *  gmres_cells from @p auto_unknowns (solver.auto_unknowns), else mumps;
+ *  in 3D by the mesh alone. */
+sp_linear_kind sp_linear_auto(int dim, long n_mesh_nodes, long n_unknowns, long auto_unknowns);
+/** @brief The relative residual of @p linear's solves: @p given, or for 0
+ *  the solver's own (1e-4 gmres_cells, 1e-6 gmres_amg, else 1e-10). */
+double sp_krylov_tol(int linear, double given);
 /** @brief Solver options from a scene on a mesh of @p n_mesh_nodes nodes
- *  (which `auto` depends on); the run's options leave them to the set-up,
- *  which knows its mesh. */
+ *  (which `auto` depends on; in 2D auto starts from mumps and the set-up
+ *  decides again on its first layout); the run's options leave them to
+ *  the set-up, which knows its mesh. */
 void sp_solver_options_from_scene(const sp_scene *scene, long n_mesh_nodes,
                                   sp_solver_options *opt);
 /** @brief Model parameters from a scene. */

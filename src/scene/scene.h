@@ -173,6 +173,7 @@ typedef struct {
   double newton_atol;  /**< absolute residual tolerance (unscaled 2-norm) */
   int newton_max_its;  /**< iterations before a step counts as failed */
   int ilu_fill;        /**< gmres_ilu: ILU(k) level of fill */
+  int auto_unknowns;   /**< auto in 2D: gmres_cells from this many unknowns */
   double krylov_tol;   /**< gmres_ilu: relative residual of a linear solve */
   double jacobian_reuse; /**< modified Newton: keep the factorisation while
                               each iteration cuts ||F|| by this (0: never) */

@@ -288,9 +288,18 @@ const sp_key sp_keys[] = {
              "(gmres_cells: no fill between cells, docs/3d.md) or with a "
              "Cahn-Hilliard block preconditioner of AMG V-cycles (gmres_amg: "
              "no factorisation, docs/solvers.md); auto: "
-             "mumps on a 2D mesh, on a 3D one gmres_cells below 15,000 "
+             "on a 2D mesh mumps below solver.auto_unknowns unknowns and "
+             "gmres_cells from there, decided again at each layout change, "
+             "on a 3D one gmres_cells below 15,000 "
              "nodes and gmres_amg from there (the fastest measured in "
              "each, the least memory where they tie, docs/solvers.md)"),
+    KEY_INT(SP_SEC_SOLVER, "auto_unknowns", solver.auto_unknowns, 250000, AT_LEAST(0),
+            AT_MOST(2000000000), "-",
+            "with solver.linear auto on a 2D mesh: the unknowns (2 per "
+            "(cell, node) pair of the layout) from which auto takes gmres_cells "
+            "instead of mumps; between 134,000 and 371,000 unknowns "
+            "gmres_cells became the faster, in about two thirds of "
+            "mumps' memory (docs/solvers.md)"),
     KEY_FLOAT(SP_SEC_SOLVER, "newton_rtol", solver.newton_rtol, 1e-8,
               ABOVE(0.0), BELOW(1.0), "-",
               "Newton: residual reduction relative to the first residual (with "
