@@ -145,6 +145,22 @@ void sp_scheme_extrapolate(int order, const sp_history *h, double dt, const doub
   }
 }
 
+/** factor max_i |c_i - other_i| / (atol + rtol max(|c^n_i|, |c_i|)) over
+ *  the c entries: the estimate's weighted max-norm (NaN at the first NaN:
+ *  the step is rejected). */
+static double weighted_max(const double *state, const double *state_new, const double *other,
+                           size_t n_pairs, double rtol, double atol, double factor) {
+  double norm = 0.0;
+  for (size_t p = 0; p < n_pairs; ++p) {
+    const double c = state_new[2 * p];
+    const double scale = atol + rtol * fmax(fabs(state[2 * p]), fabs(c));
+    const double e = factor * fabs(c - other[2 * p]) / scale;
+    if (isnan(e)) return e;
+    if (e > norm) norm = e;
+  }
+  return norm;
+}
+
 double sp_scheme_error(sp_scheme_kind kind, const sp_history *h, double dt,
                        const double *state, const double *state_new, size_t n_pairs,
                        double rtol, double atol, double *scratch) {
@@ -160,26 +176,12 @@ double sp_scheme_error(sp_scheme_kind kind, const sp_history *h, double dt,
     factor = h0 / (2 * h0 + h1);
   }
   sp_scheme_extrapolate(quadratic ? 2 : 1, h, dt, state, n_pairs, scratch);
-  double err = 0.0;
-  for (size_t p = 0; p < n_pairs; ++p) {
-    const double c = state_new[2 * p];
-    const double scale = atol + rtol * fmax(fabs(state[2 * p]), fabs(c));
-    const double e = factor * fabs(c - scratch[2 * p]) / scale;
-    if (isnan(e)) return e; /* rejected */
-    if (e > err) err = e;
-  }
-  return err;
+  return weighted_max(state, state_new, scratch, n_pairs, rtol, atol, factor);
 }
 
 double sp_scheme_increment(const double *state, const double *state_new, size_t n_pairs,
                            double rtol, double atol) {
-  double norm = 0.0;
-  for (size_t p = 0; p < n_pairs; ++p) {
-    const double c = state_new[2 * p];
-    const double scale = atol + rtol * fmax(fabs(state[2 * p]), fabs(c));
-    norm = fmax(norm, fabs(c - state[2 * p]) / scale);
-  }
-  return norm;
+  return weighted_max(state, state_new, state, n_pairs, rtol, atol, 1.0);
 }
 
 double sp_scheme_first_dt_cells(const sp_layout *layout, const double *state,
