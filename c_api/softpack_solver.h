@@ -221,6 +221,27 @@ int sp_solver_create(MPI_Comm comm, const sp_solver_options *options,
 /** @brief The number of ranks of the solver's communicator (0 on error). */
 int sp_solver_ranks(sp_solver s);
 
+/** What the solver holds on this rank and what this rank has sent
+ *  (sp_solver_usage_of; docs/parallel.md, "Memory and messages per rank"). */
+typedef struct {
+  double mesh_bytes;   /**< its copies of the mesh and layout: element geometry,
+                            slot, pair and DOF tables (the largest so far) */
+  double state_bytes;  /**< its full copy of the state, gathered each Newton
+                            iteration (the largest so far) */
+  double matrix_bytes; /**< the Jacobian's rows of this rank, its ghost rows
+                            and the CSR arrays handed to the linear solver
+                            (the largest so far) */
+  double sent_bytes;   /**< sent since creation: its rows in the state's
+                            gathers, its ghost rows in the residual's and
+                            the Jacobian's Exports (not the linear solver's
+                            own messages) */
+  long newton_its;     /**< the Newton iterations since creation, failed
+                            attempts' too */
+} sp_solver_usage;
+
+/** @brief What the solver holds on this rank and has sent. Local. */
+int sp_solver_usage_of(sp_solver s, sp_solver_usage *out);
+
 /**
  * @brief Take another linear solver (@p linear, sp_linear_kind, not auto)
  *        with @p krylov_tol for its solves from the next

@@ -88,6 +88,14 @@ int sp_solver_set_problem(sp_solver s, const sp_mesh_view *mesh, const sp_layout
   });
 }
 
+int sp_solver_usage_of(sp_solver s, sp_solver_usage *out) {
+  if (!s) return SP_SOLVER_ERR_INTERNAL;
+  return guarded(s, [&] {
+    need(s->impl != nullptr && out != nullptr, "sp_solver_usage_of: null argument");
+    *out = s->impl->usage();
+  });
+}
+
 int sp_solver_set_linear(sp_solver s, int linear, double krylov_tol) {
   if (!s) return SP_SOLVER_ERR_INTERNAL;
   return guarded(s, [&] {

@@ -547,6 +547,12 @@ void Solver::set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout)
   csr_val_.assign(csr_col_.size(), 0.0);
   pattern_changed_ = true;
   jacobian_fresh_ = false;
+  const double matrix = matrix_bytes(*jacobian_matrix_) + assembly_->ghost_matrix_bytes() +
+                        bytes_of(csr_ptr_) + bytes_of(csr_col_) + bytes_of(csr_from_) +
+                        bytes_of(csr_val_);
+  usage_.matrix_bytes = std::max(usage_.matrix_bytes, matrix);
+  usage_.mesh_bytes = std::max(usage_.mesh_bytes, assembly_->table_bytes());
+  usage_.state_bytes = std::max(usage_.state_bytes, 8.0 * assembly_->n_dofs());
 }
 
 void Solver::require_problem() const {
@@ -561,6 +567,7 @@ void Solver::gather(const double *x, std::vector<double> &full) const {
   MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm_);
   for (int r = 1; r < P; ++r) displs[r] = displs[r - 1] + counts[r - 1];
   full.resize(assembly_->n_dofs());
+  usage_.sent_bytes += 8.0 * mine * (P - 1);  // its rows to every other rank
   MPI_Allgatherv(x, mine, MPI_DOUBLE, full.data(), counts.data(), displs.data(), MPI_DOUBLE,
                  comm_);
 }
@@ -588,6 +595,7 @@ void Solver::fill_residual(const sp_step_data &d, const double *x, TpetraVector 
   double t0 = now();
   gather(x, full_);
   assembly_->residual(shape_.data_at(d, *assembly_, full_.data()), full_.data(), F);
+  usage_.sent_bytes += assembly_->residual_export_bytes();
   t_assembly_ += now() - t0;
 }
 
@@ -598,6 +606,7 @@ void Solver::fill_jacobian(const sp_step_data &d, const double *x) {
   // dependence on the moments is the low-rank part (prepare_shape).
   assembly_->jacobian(shape_.data_at(d, *assembly_, full_.data()), full_.data(),
                       options_.jacobian, *jacobian_matrix_);
+  usage_.sent_bytes += assembly_->jacobian_export_bytes();
   linear_->set_scales(d.dt * d.model.mobility, d.model.kappa);
   jacobian_fresh_ = true;
   if (carries()) {
@@ -821,6 +830,7 @@ int Solver::step(const sp_step_data &d, double *state, sp_step_report &report) {
     }
   }
   report.newton_its = n.solver->getNumIterations();
+  usage_.newton_its += report.newton_its;
   report.factorisations = step_factorisations_;
   report.linear_its = linear_->iterations() - linear_its_before;
   report.n_residuals = (int)std::min<size_t>(step_norms_.size(), SP_MAX_NEWTON_HISTORY);

@@ -34,6 +34,8 @@ class Solver {
   void set_problem(const sp_mesh_view &mesh, const sp_layout_view &layout);
   // Another linear solver from the next set_problem on (which rebuilds).
   void set_linear(int linear, double krylov_tol);
+  // What this rank holds and has sent (sp_solver_usage).
+  sp_solver_usage usage() const { return usage_; }
   /// Whether the next step may begin on the current factorisation
   /// (jacobian_carry), and the point its Jacobian was filled at: dt, the
   /// full state, the step's shape coefficients (for a checkpoint).
@@ -119,6 +121,8 @@ class Solver {
   MPI_Comm comm_;
   int rank_ = 0, n_ranks_ = 1;
   sp_solver_options options_;
+  // Bytes held (largest so far) and sent (mutable: the const gathers send).
+  mutable sp_solver_usage usage_{};
   std::unique_ptr<Assembly> assembly_;
   // The backend of solver.linear inside the low-rank (Woodbury) wrapper.
   std::unique_ptr<LowRankSolver> linear_;

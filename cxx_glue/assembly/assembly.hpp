@@ -32,6 +32,14 @@ using TpetraMatrix = Tpetra::CrsMatrix<double, int, GlobalId>;
 using TpetraVector = Tpetra::Vector<double, int, GlobalId>;
 using TpetraExport = Tpetra::Export<int, GlobalId>;
 
+// Bytes a std::vector holds, and a Tpetra matrix's local rows (values,
+// local column indices, row offsets).
+template <class V>
+double bytes_of(const V &v) {
+  return (double)v.capacity() * sizeof(typename V::value_type);
+}
+double matrix_bytes(const TpetraMatrix &A);
+
 class Assembly {
  public:
   Assembly(MPI_Comm comm, const sp_mesh_view &mesh, const sp_layout_view &layout);
@@ -76,6 +84,14 @@ class Assembly {
   // sum_p u[dim p + i] c_p for any c of the layout.
   void shape_weights(const sp_step_data &data, std::vector<double> &u) const;
   int pair_cell(int p) const { return pair_cell_[p]; }
+  // Bytes of this rank's copies of the mesh and layout (element geometry,
+  // pair, slot and DOF tables), of its ghost rows' matrix, and sent by one
+  // residual's and one Jacobian's Export of its ghost rows (values, and
+  // for the matrix each entry's global column and each row's length).
+  double table_bytes() const;
+  double ghost_matrix_bytes() const;
+  double residual_export_bytes() const;
+  double jacobian_export_bytes() const;
   // Gathers and computes every element matrix of this rank without adding
   // them into a matrix (the element kernel alone, for timing).
   void element_pass(const sp_step_data &data, const double *state, int kind) const;

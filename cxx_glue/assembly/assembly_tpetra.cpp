@@ -240,4 +240,32 @@ void Assembly::jacobian(const sp_step_data &d, const double *state, int kind,
   J.fillComplete(map_, map_);
 }
 
+double matrix_bytes(const TpetraMatrix &A) {
+  return (sizeof(double) + sizeof(int)) * (double)A.getNodeNumEntries() +
+         sizeof(size_t) * (double)(A.getNodeNumRows() + 1);
+}
+
+double Assembly::table_bytes() const {
+  return bytes_of(node_start_) + bytes_of(pair_cell_) + bytes_of(geo_N_) + bytes_of(geo_dNdx_) +
+         bytes_of(geo_x_) + bytes_of(geo_w_) + bytes_of(geo_buffer_) + bytes_of(my_elems_) +
+         bytes_of(elem_start_) + bytes_of(slot_cell_) + bytes_of(slot_pair_) +
+         bytes_of(row_of_dof_) + bytes_of(col_of_dof_) + bytes_of(my_rows_);
+}
+
+double Assembly::ghost_matrix_bytes() const {
+  return matrix_bytes(*ghost_jacobian_) + sizeof(double) * (double)ghost_map_->getNodeNumElements();
+}
+
+double Assembly::residual_export_bytes() const {
+  return sizeof(double) * (double)ghost_to_owner_->getNumExportIDs();
+}
+
+double Assembly::jacobian_export_bytes() const {
+  double entries = 0;
+  for (int lid : ghost_to_owner_->getExportLIDs())
+    entries += (double)ghost_jacobian_->getNumEntriesInLocalRow(lid);
+  return (sizeof(double) + sizeof(GlobalId)) * entries +
+         sizeof(size_t) * (double)ghost_to_owner_->getNumExportIDs();
+}
+
 }  // namespace sp

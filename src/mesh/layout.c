@@ -299,3 +299,14 @@ long long sp_layout_nonzeros_bound(const sp_layout *layout, int dim) {
     bound += sp_nonzeros_bound(dim, 1, layout->node_start[i + 1] - layout->node_start[i]);
   return bound;
 }
+
+double sp_layout_bytes(const sp_layout *layout) {
+  double b = sizeof(int) * ((double)layout->n_nodes + 1 + (double)layout->n_pairs);
+  const sp_layout_cache *c = layout->cache;
+  if (c && c->slots)
+    b += sizeof(int64_t) * ((double)c->slots->n_elems + 1) +
+         sizeof(int) * (double)c->slots->n_slots * (1.0 + c->slots->nodes_per_elem);
+  if (c && c->cells) b += sizeof(int64_t) * ((double)layout->n_cells + 1) +
+                          2.0 * sizeof(int) * (double)layout->n_pairs;
+  return b;
+}

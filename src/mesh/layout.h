@@ -101,6 +101,10 @@ int sp_layout_create_from_masks(int n_nodes, int n_cells,
                                 const unsigned char *in_support,
                                 sp_layout **out);
 
+/** @brief Bytes the layout holds: its pair numbering and the derived
+ *  tables built so far (slot table, cell-major pairs). */
+double sp_layout_bytes(const sp_layout *layout);
+
 /** @brief sp_nonzeros_bound summed over the layout's nodes (a mesh of
  *         dimension @p dim). */
 long long sp_layout_nonzeros_bound(const sp_layout *layout, int dim);

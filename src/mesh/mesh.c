@@ -815,3 +815,10 @@ void sp_mesh_destroy(sp_mesh **mesh) {
   free(*mesh);
   *mesh = NULL;
 }
+
+double sp_mesh_bytes(const sp_mesh *mesh) {
+  const double nn = mesh->n_nodes, ne = mesh->n_elems;
+  const double nq = mesh->q1_w ? sp_q1_qpoints(mesh->dim) : 0;
+  return sizeof(double) * mesh->dim * nn + sizeof(int) * (mesh->nodes_per_elem + 1.0) * ne +
+         sizeof(double) * (1.0 + mesh->dim) * nq * ne;
+}

@@ -48,6 +48,10 @@ typedef struct sp_mesh {
   double *q1_w, *q1_x;
 } sp_mesh;
 
+/** @brief Bytes the mesh holds: coordinates, connectivity, regions and
+ *  the Gauss points' geometry. */
+double sp_mesh_bytes(const sp_mesh *mesh);
+
 /**
  * @brief Rectangle [x0,x1] x [y0,y1] with nx x ny elements.
  * @param[out] out the new mesh (destroy with sp_mesh_destroy)

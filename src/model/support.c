@@ -739,3 +739,9 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
   free(layers);
   return rc;
 }
+
+double sp_support_bytes(const sp_support s) {
+  const double nn = s->mesh->n_nodes;
+  return sizeof(int) * (nn + 1 + (double)s->mesh->n_elems * s->mesh->nodes_per_elem) +
+         (2 * sizeof(int) + sizeof(double) + 2) * nn + nn;
+}

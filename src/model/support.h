@@ -64,6 +64,10 @@ typedef struct {
   sp_support_buffer_kind buffer;   /**< layout.buffer_elements */
 } sp_support_params;
 
+/** @brief Bytes the support module holds: the elements around each node
+ *  and its per-node scratch. */
+double sp_support_bytes(const sp_support s);
+
 /** @brief Node adjacency of a mesh and the parameters. */
 int sp_support_create(const sp_mesh *mesh, const sp_support_params *params,
                       sp_support *out);

@@ -44,6 +44,17 @@ typedef struct {
   double t_checkpoints; /**< seconds spent writing them (rank 0) */
   int stopped;         /**< SP_STOPPED_CALLBACK or SP_STOPPED_SIGNAL if the run
                             stopped early, else 0 */
+  /* Memory per rank (MB), each the largest over the ranks, and what a rank
+   * sent per Newton iteration (docs/parallel.md, "Memory and messages per
+   * rank"): */
+  double mb_mesh;      /**< the mesh, layout and support tables, the glue's copies */
+  double mb_state;     /**< the state, its history, the step's buffers, the
+                            glue's full copy */
+  double mb_matrix;    /**< the Jacobian's rows and ghost rows, the CSR arrays */
+  double mb_solver;    /**< the rest of the resident peak: the linear solver's
+                            factors or hierarchies and work arrays */
+  double mb_sent_per_newton; /**< the state's gathers and the residual's and
+                                  Jacobian's Exports, per Newton iteration */
 } sp_run_summary;
 
 /** Why a run stopped before t_end (sp_run_summary.stopped). */

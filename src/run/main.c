@@ -75,6 +75,9 @@ static void print_summary(const sp_run_summary *sum, const char *out_dir) {
            sum->support_mass_dropped, sum->support_energy_rise, sum->unknowns_max);
   else
     printf("softpack: at most %ld unknowns per step\n", sum->unknowns_max);
+  printf("softpack: memory per rank (MB): mesh %.1f, state %.1f, matrix %.1f, solver %.1f; "
+         "sent per Newton iteration (MB): %.3f\n",
+         sum->mb_mesh, sum->mb_state, sum->mb_matrix, sum->mb_solver, sum->mb_sent_per_newton);
   if (sum->checkpoints)
     printf("softpack: %d checkpoints written (%.2f s)\n", sum->checkpoints, sum->t_checkpoints);
   char gmres[64] = "";

@@ -1,5 +1,6 @@
 #include "run/resize.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -57,6 +58,24 @@ static int alloc_step_buffers(sp_run *run) {
   return SP_OK;
 }
 
+/** The largest so far of what the core holds on this rank: the mesh, the
+ *  layout and the support module; the state, the history (up to two past
+ *  states where the scheme, the estimate or the predictor keeps them) and
+ *  the step's buffers. */
+static void count_bytes(sp_run *run) {
+  const sp_run_options *o = &run->opt;
+  const double pair = 8.0 * (double)run->layout->n_pairs; /* one double per pair */
+  const int history = o->time.adaptive || o->time.scheme == SP_SCHEME_BDF2 ||
+                      o->time.predictor_linear;
+  const double state = 2 * pair /* state */ + 2 * pair + pair /* state_old, source */ +
+                       (o->time.scheme == SP_SCHEME_BDF2 ? 2 * pair : 0) +
+                       (o->time.adaptive ? 2 * pair : 0) + (history ? 4 * pair : 0);
+  double mesh = sp_mesh_bytes(run->mesh) + sp_layout_bytes(run->layout);
+  if (run->support) mesh += sp_support_bytes(run->support);
+  run->bytes_mesh = fmax(run->bytes_mesh, mesh);
+  run->bytes_state = fmax(run->bytes_state, state);
+}
+
 /** solver.linear auto: the solver for the run's layout (in 2D it depends on
  *  the unknowns); a change takes effect at the attach that follows. */
 static int pick_linear(sp_run *run) {
@@ -96,5 +115,7 @@ int sp_run_resize(sp_run *run, sp_layout *layout, double *state, sp_history_move
   SP_CALL(sp_registry_resize(&run->cells, layout->n_cells));
   SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* attaching is collective */
   SP_CALL(pick_linear(run));
-  return sp_solver_attach(run->solver, run->mesh, run->layout);
+  SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
+  count_bytes(run); /* (after the attach: the slot table is built) */
+  return SP_OK;
 }

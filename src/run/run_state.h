@@ -110,6 +110,9 @@ typedef struct {
   int restarted;        /**< 1: continued from a checkpoint (not as initial) */
   /* scratch of a step */
   sp_step_buffers buf;
+  /* what this rank's core holds, the largest so far (resize.c): the mesh,
+   * layout and support tables; the state, its history and the buffers */
+  double bytes_mesh, bytes_state;
   /* output */
   sp_monitor mon;
   sp_scene_source_text scene_text;

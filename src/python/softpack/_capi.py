@@ -83,7 +83,12 @@ class RunSummary(ctypes.Structure):
                 ("unknowns_max", ctypes.c_long),
                 ("checkpoints", ctypes.c_int),
                 ("t_checkpoints", ctypes.c_double),
-                ("stopped", ctypes.c_int)]
+                ("stopped", ctypes.c_int),
+                ("mb_mesh", ctypes.c_double),
+                ("mb_state", ctypes.c_double),
+                ("mb_matrix", ctypes.c_double),
+                ("mb_solver", ctypes.c_double),
+                ("mb_sent_per_newton", ctypes.c_double)]
 
 
 class StepInfo(ctypes.Structure):
