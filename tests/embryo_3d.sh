@@ -19,14 +19,10 @@ export OMP_NUM_THREADS=1
 rm -rf "$out"
 "$bin" run "$scene" --out "$out" --quiet --set time.t_end=0.003 --set output.every=1000 \
   > "$out.log" 2>&1 || { echo "FAIL: the run failed"; tail -5 "$out.log"; exit 1; }
-python3 - "$out" <<'EOF'
+PYTHONPATH="$(dirname "$0")" python3 - "$out" <<'EOF'
 import csv, sys
 out = sys.argv[1]
-ok = True
-def check(cond, what):
-    global ok
-    print(("ok:   " if cond else "FAIL: ") + what)
-    ok = ok and cond
+from checklib import check, done
 want = [("P0", "AB", "P1", 0.592421), ("AB", "ABa", "ABp", 0.503495),
         ("P1", "EMS", "P2", 0.573656)]
 divs = list(csv.DictReader(open(out + "/divisions.csv")))
@@ -57,6 +53,5 @@ check(abs(total - p0) <= 1e-12 * p0, f"the four cells' masses sum to P0's: {tota
 for name, r in sorted(last.items()):
     inside = float(r["volume"]) / float(r["mass"])
     check(inside >= 0.5, f"{name}: c >= 1/2 volume {inside:.2f} of its mass")
-print("PASS" if ok else "FAILED")
-sys.exit(0 if ok else 1)
+done()
 EOF

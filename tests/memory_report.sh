@@ -26,14 +26,10 @@ common=(--set time.t_end=0.0002 --set output.pictures=false)
   || { echo "FAIL: the one-process run failed"; tail -5 "$out/np1.log"; exit 1; }
 "$mpiexec" "$npflag" 2 "$@" "$bin" run "$scene" --out "$out/np2" "${common[@]}" > "$out/np2.log" 2>&1 \
   || { echo "FAIL: the two-process run failed"; tail -5 "$out/np2.log"; exit 1; }
-python3 - "$out" <<'EOF'
+PYTHONPATH="$(dirname "$0")" python3 - "$out" <<'EOF'
 import re, sys
 out = sys.argv[1]
-ok = True
-def check(cond, what):
-    global ok
-    print(("ok:   " if cond else "FAIL: ") + what)
-    ok = ok and cond
+from checklib import check, done
 pattern = re.compile(r"^softpack: memory per rank \(MB\): mesh ([0-9.]+), state ([0-9.]+), "
                      r"matrix ([0-9.]+), solver ([0-9.]+); sent per Newton iteration \(MB\): "
                      r"([0-9.]+)$")
@@ -54,6 +50,5 @@ gather = 8 * unknowns / 2 / 2**20
 check(gather * (1 - 1e-3) <= sent2 <= 4 * gather,
       f"np 2: sent {sent2} MB per Newton iteration, between one and four gathers of half "
       f"the state ({gather:.3f} MB each)")
-print("PASS" if ok else "FAILED")
-sys.exit(0 if ok else 1)
+done()
 EOF
