@@ -27,6 +27,7 @@
  *    = 0.044), not with margin 12 d nor at refinements 4; sp_support_rebuild
  *    gives supports that do not in all three, widened where the computed
  *    ones would (more nodes) and as computed where not (the same nodes);
+ *    with layout.widen false as computed, needing the update;
  *  - layout.buffer_elements: with whole, no node of a support sits beside
  *    a buffer element the cell does not count unless it is in one it
  *    counts (by the margin alone some do), at the set-up and after a
@@ -248,9 +249,11 @@ static void test_auto(void) {
 
 /** Supports of one tanh sphere of radius 0.24 on the 3D run 5's
  *  ellipsoid at @p refinements, computed from the field (the set-up's
- *  masks) and then rebuilt (sp_support_rebuild): whether each needs an
- *  update right away (*computed, *rebuilt) and their node counts. */
-static void coarse_rule(int refinements, double margin, int *computed, int *rebuilt_needs,
+ *  masks) and then rebuilt (sp_support_rebuild), widened or not
+ *  (@p widen, layout.widen): whether each needs an update right away
+ *  (*computed, *rebuilt) and their node counts. */
+static void coarse_rule(int refinements, double margin, int widen, int *computed,
+                        int *rebuilt_needs,
                         long *n_computed, long *n_rebuilt, int *initial_needs,
                         long *n_initial) {
   sp_mesh *mesh;
@@ -268,7 +271,7 @@ static void coarse_rule(int refinements, double margin, int *computed, int *rebu
   const sp_support_params p = {.margin = margin * d, .core_threshold = 0.1,
                                .grow_threshold = 0.2, .band = 4 * d, .alpha = alpha,
                                .kappa = kappa, .lambda = 100, .lambda_b = 100,
-                               .fill = SP_SUPPORT_FILL_EDGE};
+                               .fill = SP_SUPPORT_FILL_EDGE, .no_widening = !widen};
   sp_support s;
   CHECK_OK(sp_support_create(mesh, &p, &s));
   unsigned char *mask = calloc((size_t)nn, 1);
@@ -306,7 +309,7 @@ static void test_coarse_rule(void) {
   for (int i = 0; i < 3; ++i) {
     int computed = -1, rebuilt = -1, initial = -1;
     long n_computed = 0, n_rebuilt = 0, n_initial = 0;
-    coarse_rule(c[i].refinements, c[i].margin, &computed, &rebuilt, &n_computed, &n_rebuilt,
+    coarse_rule(c[i].refinements, c[i].margin, 1, &computed, &rebuilt, &n_computed, &n_rebuilt,
                 &initial, &n_initial);
     CHECK(computed == c[i].computed, "refinements %d, margin %g d: the computed supports need "
           "an update: %d, expected %d", c[i].refinements, c[i].margin, computed, c[i].computed);
@@ -322,6 +325,17 @@ static void test_coarse_rule(void) {
           "refinements %d, margin %g d: set-up %ld nodes, computed %ld (%s expected)",
           c[i].refinements, c[i].margin, n_initial, n_computed, computed ? "more" : "the same");
   }
+  /* layout.widen false: the supports as computed, rebuilt and at the
+   * set-up, though they call for another update at once */
+  int computed = -1, rebuilt = -1, initial = -1;
+  long n_computed = 0, n_rebuilt = 0, n_initial = 0;
+  coarse_rule(3, 8, 0, &computed, &rebuilt, &n_computed, &n_rebuilt, &initial, &n_initial);
+  CHECK(computed == 1 && rebuilt == 1 && initial == 1,
+        "widen false: computed, rebuilt and set-up supports need an update: %d %d %d", computed,
+        rebuilt, initial);
+  CHECK(n_rebuilt == n_computed && n_initial == n_computed,
+        "widen false: rebuilt %ld and set-up %ld nodes, computed %ld", n_rebuilt, n_initial,
+        n_computed);
 }
 
 /** Nodes of cell k's support beside the buffer ring and unheld by it: a

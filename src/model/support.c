@@ -701,6 +701,7 @@ int sp_support_initial(sp_support s, const sp_layout *layout, const double *stat
       rc = sp_error_set(SP_ERR_MEMORY, "supports: out of memory");
     if (rc == SP_OK) sp_layout_transfer(layout, state, *out, cut, 0.0);
     if (rc == SP_OK) rc = widen_outgrown(s, *out, cut, layers, &outgrown);
+    if (s->params.no_widening) outgrown = 0;
   }
   free(layers);
   if (rc != SP_OK) {
@@ -735,6 +736,7 @@ int sp_support_rebuild(sp_support s, const sp_layout *layout, const double *stat
     rc = rebuild_widened(s, layout, state, may_shrink, layers, new_layout, new_state,
                          mass_correction, mass_dropped);
     if (rc == SP_OK) rc = widen_outgrown(s, *new_layout, *new_state, layers, &outgrown);
+    if (s->params.no_widening) outgrown = 0;
   }
   free(layers);
   return rc;

@@ -62,6 +62,8 @@ typedef struct {
   sp_support_fill_kind fill; /**< layout.fill */
   sp_support_restore_kind restore; /**< layout.restore */
   sp_support_buffer_kind buffer;   /**< layout.buffer_elements */
+  int no_widening; /**< layout.widen false: supports as computed, also where
+                        they would call for another update at once */
 } sp_support_params;
 
 /** @brief Bytes the support module holds: the elements around each node

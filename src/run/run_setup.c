@@ -105,7 +105,8 @@ static int maybe_local_supports(sp_run *run, const sp_scene *scene, int n_cells)
                                          : SP_SUPPORT_RESTORE_INTERIOR,
                           .buffer = ly->buffer_elements == SP_BUFFER_ELEMENTS_WHOLE
                                         ? SP_SUPPORT_BUFFER_WHOLE
-                                        : SP_SUPPORT_BUFFER_MARGIN};
+                                        : SP_SUPPORT_BUFFER_MARGIN,
+                          .no_widening = !ly->widen};
   return sp_support_create(run->mesh, &sp, &run->support);
 }
 

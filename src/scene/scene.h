@@ -269,6 +269,8 @@ typedef struct {
   sp_restore_kind restore; /**< local: where a change restores the masses */
   sp_buffer_elements_kind buffer_elements; /**< local: the buffer ring's elements a
                                                 support touches: whole, or by margin */
+  int widen;               /**< local: widen a support that would call for
+                                another update at once */
 } sp_scene_layout;
 
 /** How the shape term enters a step (src/model/shape.h). */

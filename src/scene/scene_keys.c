@@ -506,6 +506,13 @@ const sp_key sp_keys[] = {
              "beside the ring unheld (whole: far smaller energy rises at a "
              "change in the eggshell, docs/local-support.md), or the "
              "elements within the margin alone (margin: the published runs)"),
+    KEY_BOOL(SP_SEC_LAYOUT, "widen", layout.widen, 1, "-",
+             "local: a support that would call for another update as soon "
+             "as it is built (elements wider than margin - band, a far field "
+             "above grow_threshold at its edge) is widened by layers of "
+             "elements until it does not (true: one change where there were "
+             "one per step on coarse 3D meshes; false: the supports as "
+             "computed, the published aggregates, docs/local-support.md)"),
     /* shape: Pi_MI = delta^i (I^i,ref - I^i)^2 with moments in L^4 and Pi
      * in E L^2, so delta is in E / L^6 (3D: L^5, E L^3, E / L^7) */
     KEY_FLOAT(SP_SEC_SHAPE, "delta1", shape.delta1, 0.0, AT_LEAST(0.0),
