@@ -209,6 +209,12 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
   sp_lineage_daughter_names(e, parent_name, cells->name[parent], cells->name[child]);
   memcpy(cells->cut_normal[parent], normal, sizeof normal);
   memcpy(cells->cut_normal[child], normal, sizeof normal);
+  /* the daughters are sisters; the parent's sister is no one's now */
+  for (int k = 0; k < n; ++k)
+    if (cells->sister[k] == parent + 1) cells->sister[k] = 0;
+  cells->sister[parent] = child + 1;
+  cells->sister[child] = parent + 1;
+  SP_CALL(sp_agree(run->agree_comm, sp_run_adhesion_update(run)));
   const int dim = run->mesh->dim;
   /* 2D: the angle of the division line, the normal turned by -90 degrees
    * (+0, not -0, in divisions.csv) */

@@ -90,6 +90,8 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
   const sp_scene_output *out = &scene->output;
   *opt = (sp_run_options){0};
   sp_model_from_scene(scene, &opt->model);
+  opt->adhesion = (sp_adhesion_params){.sisters = scene->model.adhesion_sisters,
+                                       .non_sisters = scene->model.adhesion_non_sisters};
   sp_dt_params_from_scene(scene, &opt->time.dt);
   opt->time.scheme = tc->scheme == SP_TIME_BDF2 ? SP_SCHEME_BDF2 : SP_SCHEME_BE;
   opt->time.adaptive = tc->control == SP_CONTROL_ADAPTIVE;

@@ -225,6 +225,8 @@ void sp_run_free(sp_run *run) {
   run->buf = (sp_step_buffers){0};
   sp_history_free(&run->hist);
   sp_registry_free(&run->cells);
+  free(run->adhesion);
+  run->adhesion = NULL;
   sp_lineage_free(&run->lineage);
   sp_support_destroy(&run->support);
 }

@@ -62,6 +62,8 @@ typedef struct {
   double lambda;   /**< pair repulsion */
   double lambda_b; /**< buffer-ring penalty */
   double mobility; /**< M */
+  double adhesion_sisters;     /**< sigma of two sisters (docs/model.md, "Adhesion") */
+  double adhesion_non_sisters; /**< sigma of any other two cells */
 } sp_scene_model;
 
 /** How dt is chosen (src/time/dt_control.h). */

@@ -140,6 +140,22 @@ static int check_flatten_key(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
+/** model.adhesion_*: each below kappa, which bounds the gradient energy of
+ *  a pair alone (docs/model.md, "Adhesion"); the sum over a cell's partners
+ *  on an element is checked by the run on each layout (model/adhesion.h). */
+static int check_adhesion_keys(const sp_scene *scene, const char *file) {
+  const sp_scene_model *m = &scene->model;
+  SP_CHECK(m->adhesion_sisters < m->kappa, SP_ERR_INPUT,
+           "%s: model.adhesion_sisters: expected a number < model.kappa = %.15g (the "
+           "gradient energy is bounded below only then), got %.15g",
+           file, m->kappa, m->adhesion_sisters);
+  SP_CHECK(m->adhesion_non_sisters < m->kappa, SP_ERR_INPUT,
+           "%s: model.adhesion_non_sisters: expected a number < model.kappa = %.15g (the "
+           "gradient energy is bounded below only then), got %.15g",
+           file, m->kappa, m->adhesion_non_sisters);
+  return SP_OK;
+}
+
 static int check_time_and_mesh(const sp_scene *scene, const char *file) {
   const sp_scene_time *t = &scene->time;
   SP_CHECK(t->dt_min <= t->dt, SP_ERR_INPUT,
@@ -600,6 +616,7 @@ int sp_scene_check_cell_count(const sp_scene *scene, int n_cells, const char *ce
 
 int sp_scene_validate(const sp_scene *scene, const char *where) {
   SP_CALL(check_time_and_mesh(scene, where));
+  SP_CALL(check_adhesion_keys(scene, where));
   SP_CALL(check_3d(scene, where));
   SP_CALL(check_initial(scene, where));
   SP_CALL(check_cells(scene, where));

@@ -205,6 +205,16 @@ const sp_key sp_keys[] = {
               "buffer penalty lambda_b c_k^2 in the buffer zone"),
     KEY_FLOAT(SP_SEC_MODEL, "mobility", model.mobility, 1.0, ABOVE(0.0),
               UNBOUNDED, "L^2/(E T)", "Cahn-Hilliard mobility M"),
+    KEY_FLOAT(SP_SEC_MODEL, "adhesion_sisters", model.adhesion_sisters, 0.0, AT_LEAST(0.0),
+              UNBOUNDED, "E L^2",
+              "adhesion sigma of two sisters (the daughters of one division): energy "
+              "sigma int grad c_k . grad c_l, negative where they touch (docs/model.md, "
+              "\"Adhesion\"); on every element, a cell's sigma summed over the other cells "
+              "there must stay below kappa; 0: none"),
+    KEY_FLOAT(SP_SEC_MODEL, "adhesion_non_sisters", model.adhesion_non_sisters, 0.0,
+              AT_LEAST(0.0), UNBOUNDED, "E L^2",
+              "adhesion sigma of two cells that are not sisters (initial cells, cousins, "
+              "a cell and its aunt); as adhesion_sisters"),
     /* time */
     KEY_ENUM(SP_SEC_TIME, "control", time.control, SP_CONTROL_ADAPTIVE,
              sp_control_words, "-",
