@@ -17,6 +17,10 @@
  *    daughters of a division adhere (energy.csv's adhesion part non-zero
  *    at 2 cells); with non-sisters' only, they do not (exactly 0 at 2
  *    cells) but cousins do (non-zero at 4 cells);
+ *  - named pairs (the scene's adhesion sequence): a pair's own sigma
+ *    replaces the non-sisters' (the same run, bit for bit, as with that
+ *    sigma for non-sisters), and a pair's 0 switches it off (adhesion
+ *    exactly 0); unknown names are refused naming the key;
  *  - bad input, exit 2 naming the key: a coefficient >= kappa (the
  *    scene's check), and partners on an element summing to kappa or more
  *    (the run's, on its layout);
@@ -25,6 +29,7 @@
 #include "command.h"
 #include "fixtures.h"
 #include "output_read.h"
+#include "public/error.h"
 #include "run/stepper.h"
 #include "scene/scene.h"
 
@@ -254,6 +259,65 @@ static void sisters_from_lineage(void) {
   CHECK(o4 > 0, "cousins do not adhere: %g", o4);
 }
 
+/* adhesion_pair.yaml with named cells and @p pairs, @p steps steps. */
+static const char named_scene[] =
+    "mesh: {type: rectangle, x0: 0, y0: 0, x1: 0.6, y1: 0.4, nx: 72, ny: 48}\n"
+    "model: {alpha: 4, kappa: 1.0e-3, lambda: 100, mobility: 1, adhesion_non_sisters: %s}\n"
+    "time: {control: fixed, scheme: be, dt: 2.0e-4, t_end: 1.0, max_steps: 6}\n"
+    "noise: {background: 0.0, amplitude: 0.0}\n"
+    "cells:\n"
+    "  - {x: 0.185, y: 0.2, radius: 0.1, name: A}\n"
+    "  - {x: 0.415, y: 0.2, radius: 0.1, name: B}\n"
+    "adhesion:\n"
+    "  - {cell: B, other: %s, sigma: %s}\n"
+    "output: {every: 1000, pictures: false}\n"
+    "solver: {linear: superlu, predictor: none, jacobian_reuse: 0}\n";
+
+static int run_named(const char *non_sisters, const char *other, const char *sigma,
+                     const char *out) {
+  char text[2048];
+  snprintf(text, sizeof text, named_scene, non_sisters, other, sigma);
+  sp_scene *scene;
+  const int rc = sp_scene_load_text("named.yaml", text, strlen(text), 0, NULL, &scene);
+  if (rc != SP_OK) return rc;
+  sp_run_summary sum;
+  CHECK_OK(sp_stepper_run(scene, out, MPI_COMM_WORLD, &sum));
+  sp_scene_destroy(&scene);
+  return SP_OK;
+}
+
+static void named_pairs(void) {
+  const char *six[] = {"time.max_steps=6"};
+  CHECK_OK(run_scene(SP_SOURCE_DIR "/tests/scenes/adhesion_pair.yaml", 1, six,
+                     "test_adhesion_six"));
+  CHECK_OK(run_named("0", "A", "5.0e-4", "test_adhesion_named"));
+  CHECK_OK(run_named("5.0e-4", "A", "0", "test_adhesion_named_off"));
+  csv_table ref, named, off;
+  CHECK(csv_read("test_adhesion_six/energy.csv", &ref) == 0, "energy.csv unreadable");
+  CHECK(csv_read("test_adhesion_named/energy.csv", &named) == 0, "energy.csv unreadable");
+  CHECK(csv_read("test_adhesion_named_off/energy.csv", &off) == 0, "energy.csv unreadable");
+  CHECK(ref.n_rows == 7 && named.n_rows == 7 && off.n_rows == 7, "rows %d, %d, %d", ref.n_rows,
+        named.n_rows, off.n_rows);
+  int same = 1, zero = 1;
+  for (int i = 0; i < 7 && i < named.n_rows && i < off.n_rows && i < ref.n_rows; ++i) {
+    same &= at(&ref, i, "energy") == at(&named, i, "energy") &&
+            at(&ref, i, "adhesion") == at(&named, i, "adhesion");
+    zero &= at(&off, i, "adhesion") == 0.0;
+  }
+  printf("named pair B, A: sigma 5e-4 %s the non-sisters' run (adhesion %.6g at step 6); "
+         "sigma 0 over non-sisters' 5e-4: adhesion %s\n", same ? "equals" : "differs from",
+         at(&named, 6, "adhesion"), zero ? "0 at every step" : "not 0");
+  CHECK(same, "a named pair's sigma is not the non-sisters' run");
+  CHECK(zero, "a named pair's 0 did not switch adhesion off");
+  csv_free(&ref);
+  csv_free(&named);
+  csv_free(&off);
+  const int rc = run_named("0", "C", "5.0e-4", "test_adhesion_named_bad");
+  printf("unknown name: %s\n", sp_error_message());
+  CHECK(rc == SP_ERR_INPUT && strstr(sp_error_message(), "adhesion[0].other"),
+        "an unknown name: status %d, %s", rc, sp_error_message());
+}
+
 static void bad_input(void) {
   static char out[16384];
   int status = run_softpack("run " SP_SOURCE_DIR "/tests/scenes/adhesion_pair.yaml --out "
@@ -299,6 +363,7 @@ int main(int argc, char **argv) {
   cli_check_jacobian(SP_SOURCE_DIR "/tests/scenes/adhesion_pair.yaml", "--steps 2");
   cli_check_jacobian(SP_SOURCE_DIR "/tests/scenes/adhesion_3d.yaml", "--steps 1");
   bad_input();
+  named_pairs();
   energy_law_and_contact();
   sisters_from_lineage();
   MPI_Finalize();

@@ -2,19 +2,37 @@
 #include "model/adhesion.h"
 
 #include <stdio.h>
+#include <string.h>
 
 #include "public/error.h"
 
 int sp_adhesion_on(const sp_adhesion_params *p) {
-  return p->sisters > 0 || p->non_sisters > 0;
+  int on = p->sisters > 0 || p->non_sisters > 0;
+  for (int i = 0; i < p->n_pairs; ++i) on |= p->pair[i].sigma > 0;
+  return on;
 }
 
-void sp_adhesion_table(const sp_adhesion_params *p, int n, const int *sister, double *table) {
+/** The cell named @p name among @p n (-1: none). */
+static int cell_named(int n, const sp_cell_name *names, const char *name) {
+  for (int k = 0; k < n; ++k)
+    if (strcmp(names[k], name) == 0) return k;
+  return -1;
+}
+
+void sp_adhesion_table(const sp_adhesion_params *p, int n, const int *sister,
+                       const sp_cell_name *names, double *table) {
   for (int k = 0; k < n; ++k)
     for (int l = 0; l < n; ++l)
       table[(size_t)n * k + l] = l == k                                       ? 0.0
                                  : sister[k] == l + 1 && sister[l] == k + 1 ? p->sisters
                                                                             : p->non_sisters;
+  if (!names) return;
+  for (int i = 0; i < p->n_pairs; ++i) {
+    const int k = cell_named(n, names, p->pair[i].cell),
+              l = cell_named(n, names, p->pair[i].other);
+    if (k < 0 || l < 0) continue; /* not both alive (yet, or any more) */
+    table[(size_t)n * k + l] = table[(size_t)n * l + k] = p->pair[i].sigma;
+  }
 }
 
 int sp_adhesion_check(const sp_adhesion_params *p, const double *table, int n,
@@ -43,10 +61,12 @@ int sp_adhesion_check(const sp_adhesion_params *p, const double *table, int n,
   else
     snprintf(cell, sizeof cell, "cell %d", worst_cell + 1);
   return sp_error_set(SP_ERR_INPUT,
-                      "model.adhesion_sisters = %.6g, model.adhesion_non_sisters = %.6g: on "
-                      "element %d, where %d cells live, %s has adhesion summed over the "
+                      "model.adhesion_sisters = %.6g, model.adhesion_non_sisters = %.6g%s: "
+                      "on element %d, where %d cells live, %s has adhesion summed over the "
                       "others of %.6g, not below model.kappa = %.6g (the gradient energy "
                       "would not be bounded below): lower the coefficients to below kappa "
                       "divided by the cells that meet on an element",
-                      p->sisters, p->non_sisters, worst_elem, worst_count, cell, worst, kappa);
+                      p->sisters, p->non_sisters,
+                      p->n_pairs ? " and the named pairs' adhesion[i].sigma" : "", worst_elem,
+                      worst_count, cell, worst, kappa);
 }

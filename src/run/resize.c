@@ -86,7 +86,8 @@ int sp_run_adhesion_update(sp_run *run) {
   double *table = realloc(run->adhesion, sizeof(double) * ((size_t)n * n + 1));
   SP_CHECK(table, SP_ERR_MEMORY, "out of memory for the adhesion table of %d cells", n);
   run->adhesion = table;
-  sp_adhesion_table(&run->opt.adhesion, n, run->cells.sister, table);
+  sp_adhesion_table(&run->opt.adhesion, n, run->cells.sister,
+                    (const sp_cell_name *)run->cells.name, table);
   run->opt.model.adhesion = table;
   run->opt.model.adhesion_cells = n;
   const sp_slots *slots;

@@ -129,6 +129,14 @@ typedef struct {
   double direction[3]; /**< axis fixed: the normal (x, y, z; NaN: not given) */
 } sp_scene_lineage;
 
+/** One named pair of the adhesion table: its sigma, instead of the sisters'
+ *  or non-sisters' (src/model/adhesion.h). */
+typedef struct {
+  char cell[SP_CELL_NAME_MAX];  /**< one cell's name */
+  char other[SP_CELL_NAME_MAX]; /**< the other's */
+  double sigma;                 /**< their adhesion coefficient */
+} sp_scene_adhesion;
+
 /** @brief The semi-axis of @p cell along coordinate @p d (0, 1, 2): its
  *         semi_x, semi_y or semi_z if given, else its radius. */
 double sp_scene_cell_semi_axis(const sp_scene_cell *cell, int d);
@@ -315,6 +323,8 @@ typedef struct sp_scene {
   sp_scene_cell *cells;
   int n_lineage;       /**< entries of the lineage table (0: none) */
   sp_scene_lineage *lineage;
+  int n_adhesion;      /**< named pairs with their own adhesion (0: none) */
+  sp_scene_adhesion *adhesion;
 } sp_scene;
 
 /**

@@ -18,7 +18,7 @@
 /** The sections' names, by sp_section. */
 const char *const sp_section_names[SP_N_SECTIONS] = {
     "mesh", "model", "time", "noise", "solver", "output", "division", "source",
-    "layout", "shape", "initial", "cells", "lineage"};
+    "layout", "shape", "initial", "cells", "lineage", "adhesion"};
 
 static const char *const sp_key_type_names[] = {"float", "int", "uint", "bool",
                                                  "enum",  "path", "name"};
@@ -139,6 +139,11 @@ _Static_assert(sizeof(sp_linear_kind) == sizeof(int), "enum size");
   {SP_SEC_LINEAGE, name, SP_KEY_ENUM,                                          \
    ENUM_MEMBER_OFFSET(sp_scene_lineage, member), def, 0, UNBOUNDED, UNBOUNDED, \
    words, CYAML_ARRAY_LEN(words), unit, meaning}
+
+#define ADHESION_FLOAT_REQUIRED(name, member, lo, hi, unit, meaning)          \
+  {SP_SEC_ADHESION, name, SP_KEY_FLOAT,                                        \
+   MEMBER_OFFSET(sp_scene_adhesion, member, double), 0.0, 1, lo, hi, NULL, 0,  \
+   unit, meaning}
 
 /* Units: L = the model's length unit, T = its time unit, E = its energy per
  * unit area (the energy density of Pi); "-" = dimensionless. Defaults are
@@ -624,6 +629,15 @@ const sp_key sp_keys[] = {
                   "axis fixed: y component of the cut's normal"),
     LINEAGE_FLOAT("direction_z", direction[2], NAN, UNBOUNDED, UNBOUNDED, "-",
                   "axis fixed: z component of the cut's normal (3D meshes only)"),
+    /* adhesion: one mapping per named pair with a sigma of its own (src/model/adhesion.h) */
+    NAME_KEY(SP_SEC_ADHESION, sp_scene_adhesion, "cell", cell, 1,
+             "one cell of the pair: an initial cell's name or a daughter of a lineage entry"),
+    NAME_KEY(SP_SEC_ADHESION, sp_scene_adhesion, "other", other, 1,
+             "the other cell of the pair (as cell)"),
+    ADHESION_FLOAT_REQUIRED("sigma", sigma, AT_LEAST(0.0), UNBOUNDED, "E L^2",
+                            "the pair's adhesion sigma while both cells exist, instead of "
+                            "model.adhesion_sisters or model.adhesion_non_sisters (0: none "
+                            "between them); below kappa"),
 };
 
 _Static_assert(sizeof sp_keys / sizeof sp_keys[0] == SP_N_KEYS,
