@@ -36,7 +36,8 @@ void sp_adhesion_table(const sp_adhesion_params *p, int n, const int *sister,
 }
 
 int sp_adhesion_check(const sp_adhesion_params *p, const double *table, int n,
-                      const sp_slots *slots, double kappa, const sp_cell_name *names) {
+                      const sp_slots *slots, double kappa, const sp_cell_name *names,
+                      double *largest) {
   double worst = 0.0;
   int worst_cell = -1, worst_elem = -1, worst_count = 0;
   for (int e = 0; e < slots->n_elems; ++e) {
@@ -54,6 +55,7 @@ int sp_adhesion_check(const sp_adhesion_params *p, const double *table, int n,
       }
     }
   }
+  *largest = worst;
   if (worst < kappa) return SP_OK;
   char cell[SP_CELL_NAME_MAX + 32];
   if (names && names[worst_cell][0])

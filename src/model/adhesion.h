@@ -52,9 +52,12 @@ void sp_adhesion_table(const sp_adhesion_params *p, int n, const int *sister,
  *        dominant on the element). SP_ERR_INPUT naming the scene's keys,
  *        the cell (its name from @p names when not NULL) and the sum when
  *        it is not.
+ * @param[out] largest the largest such sum (kappa minus it bounds the
+ *             gradient energy's coefficient from below)
  */
 int sp_adhesion_check(const sp_adhesion_params *p, const double *table, int n,
-                      const sp_slots *slots, double kappa, const sp_cell_name *names);
+                      const sp_slots *slots, double kappa, const sp_cell_name *names,
+                      double *largest);
 
 #ifdef __cplusplus
 }

@@ -93,5 +93,5 @@ int sp_run_adhesion_update(sp_run *run) {
   const sp_slots *slots;
   SP_CALL(sp_layout_slots(run->layout, run->mesh, &slots));
   return sp_adhesion_check(&run->opt.adhesion, table, n, slots, run->opt.model.kappa,
-                           (const sp_cell_name *)run->cells.name);
+                           (const sp_cell_name *)run->cells.name, &run->adhesion_sum);
 }

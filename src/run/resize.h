@@ -43,7 +43,9 @@ int sp_run_resize(sp_run *run, sp_layout *layout, double *state, sp_history_move
  *        bound on its layout (SP_ERR_INPUT naming the keys when a cell's
  *        partners on an element sum to kappa or more). Nothing without
  *        adhesion. Called by sp_run_resize, and again where the registry's
- *        sisters change (a division, a checkpoint restore).
+ *        sisters change (a division, a checkpoint restore). Sets
+ *        run->adhesion_sum, the largest sum of a cell's partners' sigma on
+ *        an element.
  */
 int sp_run_adhesion_update(sp_run *run);
 

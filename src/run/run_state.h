@@ -108,6 +108,8 @@ typedef struct {
   double *adhesion;     /**< the cells' adhesion table (n_cells^2, from the
                              registry's sisters; NULL without adhesion):
                              opt.model.adhesion points to it (resize.h) */
+  double adhesion_sum;  /**< the largest sum of a cell's partners' sigma on
+                             an element of the layout (0 without adhesion) */
   int n_max;            /**< N_max */
   sp_lineage lineage;   /**< the lineage table (lineage.h; from the scene) */
   int restarted;        /**< 1: continued from a checkpoint (not as initial) */
