@@ -136,6 +136,13 @@ typedef struct {
 /** Model parameters (docs/model.md). */
 typedef struct {
   double alpha, kappa, lambda, lambda_b, mobility;
+  /** Adhesion (docs/model.md, "Adhesion"): sigma_kl of cells k and l at
+   *  adhesion[adhesion_cells k + l], symmetric, zero diagonal, borrowed;
+   *  the energy gets sum_{k<l} sigma_kl int grad c_k . grad c_l. NULL: none
+   *  (then adhesion_cells is not read). adhesion_cells is at least the
+   *  layout's cell count. */
+  const double *adhesion;
+  int adhesion_cells;
 } sp_model_params;
 
 /**
@@ -204,9 +211,10 @@ typedef struct {
   char reason[512];     /**< why it failed (empty when converged) */
 } sp_step_report;
 
-/** Energy parts (docs/model.md); shape is added by the C core. */
+/** Energy parts (docs/model.md); shape is added by the C core. adhesion:
+ *  sum_{k<l} sigma_kl int grad c_k . grad c_l (0 without adhesion). */
 typedef struct {
-  double bulk, gradient, repulsion, buffer;
+  double bulk, gradient, repulsion, buffer, adhesion;
 } sp_energy_parts;
 
 /**

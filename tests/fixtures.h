@@ -263,6 +263,6 @@ static inline double energy_total(sp_solver s, const sp_model_params *m, const d
     fprintf(stderr, "energy: %s\n", sp_solver_last_error(s));
     exit(1);
   }
-  return e.bulk + e.gradient + e.repulsion + e.buffer;
+  return e.bulk + e.gradient + e.repulsion + e.buffer + e.adhesion;
 }
 #endif

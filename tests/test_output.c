@@ -157,9 +157,9 @@ int main(void) {
   CHECK(out && strcmp(sp_output_dir(out), DIR) == 0, "dir %s",
         out ? sp_output_dir(out) : "(null)");
   const double tv[3] = {0.0, 1.0 / 3.0, 2e-4 * 7.1};
-  const sp_energy_parts parts[3] = {{1.0 / 3.0, 1e-300, -2.5e10, 0.1},
-                                    {3.14159265358979, 2.0 / 7.0, 0, 0},
-                                    {1e17 + 3, -0.0, 5e-324, 1.1}};
+  const sp_energy_parts parts[3] = {{1.0 / 3.0, 1e-300, -2.5e10, 0.1, 0},
+                                    {3.14159265358979, 2.0 / 7.0, 0, 0, 0},
+                                    {1e17 + 3, -0.0, 5e-324, 1.1, 0}};
   const double shape[3] = {0.0, 1.0 / 9.0, 123.456};
   /* exact in %.4g */
   const sp_step_costs seconds = {2.5, 0.25, 2.0, 0.125, 0.5, 1, 123456789, 3, 2, 17, 37.5, 4321,

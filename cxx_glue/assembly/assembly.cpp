@@ -144,6 +144,26 @@ void Assembly::gather(int e, const sp_step_data &d, const double *state,
   else
     gather_q1<4>(nc, s0, slot_pair_.data(), slot_cell_.data(), d, state, g.u, g.c_old, g.source,
                  g.dof, g.shape);
+  gather_adhesion(e, d.model, g);
+}
+
+void Assembly::gather_adhesion(int e, const sp_model_params &m, Gathered &g) const {
+  g.has_adhesion = false;
+  if (!m.adhesion || g.n_cells < 2) return;
+  if (m.adhesion_cells < n_cells_)
+    throw std::invalid_argument("the adhesion table has " + std::to_string(m.adhesion_cells) +
+                                " cells, the layout " + std::to_string(n_cells_));
+  const int nc = g.n_cells;
+  const int64_t s0 = elem_start_[e];
+  g.adhesion.assign((size_t)nc * nc, 0.0);
+  for (int j = 0; j < nc; ++j)
+    for (int l = 0; l < nc; ++l) {
+      if (l == j) continue;
+      const double sigma =
+          m.adhesion[(size_t)m.adhesion_cells * slot_cell_[s0 + j] + slot_cell_[s0 + l]];
+      g.adhesion[(size_t)nc * j + l] = sigma;
+      if (sigma != 0.0) g.has_adhesion = true;
+    }
 }
 
 namespace {
@@ -227,12 +247,17 @@ void Assembly::element_rhs(int e, const sp_step_data &d, const Gathered &g, doub
 }
 
 sp_energy_parts Assembly::energy(const sp_model_params &m, const double *state) const {
-  double local[4] = {0, 0, 0, 0};  // bulk, gradient, repulsion, buffer
+  double local[5] = {0, 0, 0, 0, 0};  // bulk, gradient, repulsion, buffer, adhesion
   agree_local(comm_, [&] {
+    Gathered g;           // (only its adhesion table)
+    std::vector<double> grads;  // the slots' grad c at a point (adhesion)
     for (int e : my_elems_) {
       const ElementGeometry geo = geometry(e);
       const int nc = n_cells_on(e);
       const int64_t s0 = elem_start_[e];
+      g.n_cells = nc;
+      gather_adhesion(e, m, g);
+      if (g.has_adhesion) grads.assign((size_t)dim_ * nc, 0.0);
       for (int q = 0; q < nq_; ++q) {
         const double w = geo.w(q);
         double sum_sq = 0, sum_4 = 0;
@@ -249,15 +274,26 @@ sp_energy_parts Assembly::energy(const sp_model_params &m, const double *state) 
           sum_sq += c * c;
           sum_4 += c * c * c * c;
           if (geo.buffer) local[3] += w * m.lambda_b * c * c;
+          if (g.has_adhesion)
+            for (int d = 0; d < dim_; ++d) grads[(size_t)dim_ * j + d] = gc[d];
         }
         // lambda sum_{k<l} c_k^2 c_l^2 = lambda/2 ((sum c^2)^2 - sum c^4)
         local[2] += w * 0.5 * m.lambda * (sum_sq * sum_sq - sum_4);
+        // sum_{k<l} sigma_kl grad c_k . grad c_l
+        if (g.has_adhesion)
+          for (int j = 0; j < nc; ++j)
+            for (int l = j + 1; l < nc; ++l) {
+              const double sigma = g.adhesion[(size_t)nc * j + l];
+              if (sigma != 0.0)
+                local[4] += w * sigma * grad_dot(&grads[(size_t)dim_ * j],
+                                                 &grads[(size_t)dim_ * l], dim_);
+            }
       }
     }
   });
-  double global[4];
-  check_mpi(MPI_Allreduce(local, global, 4, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
-  return sp_energy_parts{global[0], global[1], global[2], global[3]};
+  double global[5];
+  check_mpi(MPI_Allreduce(local, global, 5, MPI_DOUBLE, MPI_SUM, comm_), "MPI_Allreduce");
+  return sp_energy_parts{global[0], global[1], global[2], global[3], global[4]};
 }
 
 double Assembly::check_jacobian(const sp_step_data &d, const double *state, int kind) const {

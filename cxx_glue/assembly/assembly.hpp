@@ -103,11 +103,16 @@ class Assembly {
     std::vector<double> u, c_old, source;
     std::vector<int> dof;  // global DOF of each element unknown, -1 if absent
     std::vector<const sp_shape_coef *> shape;
+    // sigma of slots j and l at [n_cells j + l]; has_adhesion: some
+    // entry is not 0 (else the element has no adhesion term)
+    std::vector<double> adhesion;
+    bool has_adhesion = false;
     ElementInputs inputs(const sp_step_data &d) const {
       ElementInputs in;
       in.c_old = c_old.data();
       in.source = d.source ? source.data() : nullptr;
       in.shape = d.shape ? shape.data() : nullptr;
+      in.adhesion = has_adhesion ? adhesion.data() : nullptr;
       in.dt = d.dt;
       in.model = d.model;
       return in;
@@ -122,6 +127,8 @@ class Assembly {
   }
   void gather(int e, const sp_step_data &data, const double *state,
               Gathered &g) const;
+  // The adhesion table of element e's slots into g (g.n_cells set).
+  void gather_adhesion(int e, const sp_model_params &m, Gathered &g) const;
   void element_matrix(int e, const sp_step_data &data, const Gathered &g,
                       int kind, double *R, double *K) const;
   // The element residual alone (R: 2 nen_ g.n_cells entries, zeroed first).
@@ -161,7 +168,8 @@ class Assembly {
 
 // Whether the entry (row of slot j field f, column of slot j2 field f2)
 // can be non-zero: c-rows see only their own cell; mu-rows see their own
-// cell and the c of every other cell present (the repulsion).
+// cell and the c of every other cell present (the repulsion, and the
+// adhesion's stiffness blocks).
 inline bool coupled(int j, int f, int j2, int f2) {
   if (j == j2) return true;
   return f == 1 && f2 == 0;

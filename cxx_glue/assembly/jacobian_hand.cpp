@@ -11,7 +11,10 @@
 //   dR_mu[k,a] / dmu_k[b] = M_ab
 //   dR_mu[k,a] / dc_k[b]  = -int N_a N_b [f''(c_k) + 2 lambda (S - c_k^2)
 //                                         (+ 2 lambda_b)] - kappa L_ab
-//   dR_mu[k,a] / dc_l[b]  = -int N_a N_b 4 lambda c_k c_l     (l != k)
+//   dR_mu[k,a] / dc_l[b]  = -int N_a N_b 4 lambda c_k c_l - sigma_kl L_ab  (l != k)
+//
+// (sigma_kl: adhesion, whose R_mu[k,a] term is -sigma_kl int grad N_a .
+// grad c_l: linear in c_l, so its block is the stiffness matrix)
 //
 // and every other block is zero (coupled() in assembly.hpp). The pointwise
 // values and derivatives come from physics.hpp. Quadrilaterals and
@@ -86,11 +89,22 @@ void hand_element_q1(const ElementGeometry &geo, int nc, const double *u,
       if (in.shape && in.shape[j] && c_old >= in.shape[j]->threshold)
         local += shape_mu(*in.shape[j], g.x[q], dim);
       dq[q * nc + j] = d2;
+      double ga[dim] = {};  // sum_l sigma_jl grad c_l: adhesion (residual.hpp)
+      if (in.adhesion)
+        for (int l = 0; l < nc; ++l) {
+          const double sigma = in.adhesion[nc * j + l];
+          if (l == j || sigma == 0.0) continue;
+          for (int a = 0; a < nen; ++a) {
+            const double cla = u[(nen * l + a) * 2];
+            for (int d = 0; d < dim; ++d) ga[d] += sigma * g.dNdx[q][a][d] * cla;
+          }
+        }
       const double rate = c - c_old - in.dt * s;
       for (int a = 0; a < nen; ++a) {
         const double *dN = g.dNdx[q][a];
         R[(nen * j + a) * 2] += w * (N[a] * rate + in.dt * m.mobility * grad_dot(dN, gmu, dim));
         R[(nen * j + a) * 2 + 1] += w * (N[a] * (mu - local) - m.kappa * grad_dot(dN, gc, dim));
+        if (in.adhesion) R[(nen * j + a) * 2 + 1] -= w * grad_dot(dN, ga, dim);
       }
     }
   }
@@ -114,18 +128,21 @@ void hand_element_q1(const ElementGeometry &geo, int nc, const double *u,
     }
   }
 
-  // Cross-cell blocks dR_mu[j]/dc_l = dR_mu[l]/dc_j: once per unordered pair.
+  // Cross-cell blocks dR_mu[j]/dc_l = dR_mu[l]/dc_j: once per unordered pair
+  // (sigma_jl = sigma_lj: the adhesion table is symmetric).
   for (int j = 0; j < nc; ++j)
     for (int l = j + 1; l < nc; ++l) {
       double d[Q];
       for (int q = 0; q < Q; ++q)
         d[q] = repulsion_d2_cross(m, cq[q * nc + j], cq[q * nc + l]);
+      const double sigma = in.adhesion ? in.adhesion[nc * j + l] : 0.0;
       for (int a = 0; a < nen; ++a) {
         double *Kjl = K + (size_t)((nen * j + a) * 2 + 1) * n + 2 * nen * l;  // row mu_j, cols c_l
         double *Klj = K + (size_t)((nen * l + a) * 2 + 1) * n + 2 * nen * j;  // row mu_l, cols c_j
         for (int b = 0; b < nen; ++b) {
           double v = 0.0;
           for (int q = 0; q < Q; ++q) v += d[q] * NN[q][a][b];
+          if (sigma != 0.0) v += sigma * Lab[a][b];
           Kjl[2 * b] = -v;
           Klj[2 * b] = -v;
         }

@@ -13,7 +13,9 @@
 //   R_c  = int N_a (c - c_old) + dt M grad N_a . grad mu - dt N_a s
 //   R_mu = int N_a mu - N_a [f'(c) + 2 lambda c sum_{l!=k} c_l^2
 //                            (+ 2 lambda_b c in the buffer) + shape(X)]
-//          - kappa grad N_a . grad c
+//          - kappa grad N_a . grad c - sum_{l!=k} sigma_kl grad N_a . grad c_l
+// (the last sum: adhesion, docs/model.md "Adhesion"; only when the step has
+// an adhesion table)
 #ifndef SP_RESIDUAL_HPP
 #define SP_RESIDUAL_HPP
 
@@ -82,6 +84,9 @@ struct ElementInputs {
   const double *c_old;   // nodes x n_cells nodal c^n (slot-major)
   const double *source;  // nodes x n_cells nodal s_k (slot-major), or nullptr
   const sp_shape_coef *const *shape;  // n_cells entries or nullptr
+  // sigma of the element's slots j and l at [n_cells j + l] (symmetric,
+  // zero diagonal), or nullptr: no adhesion on the element
+  const double *adhesion;
   double dt;
   sp_model_params model;
 };
@@ -145,6 +150,22 @@ void element_residual_q1(const ElementGeometry &geo, int n_cells, const S *u,
                                        (dN[0] * gm[0] + dN[1] * gm[1] + dN[2] * gm[2]));
           Rmu += w * (N[a] * (mu[j] - local) -
                       m.kappa * (dN[0] * gcj[0] + dN[1] * gcj[1] + dN[2] * gcj[2]));
+        }
+      }
+      if (in.adhesion) {
+        // adhesion: mu_k gets -sum_l sigma_kl lap c_l, in weak form
+        // -sigma_kl grad N_a . grad c_l in R_mu
+        S ga[dim];
+        for (int d = 0; d < dim; ++d) ga[d] = 0.0;
+        for (int l = 0; l < n_cells; ++l) {
+          const double sigma = in.adhesion[n_cells * j + l];
+          if (l == j || sigma == 0.0) continue;
+          for (int d = 0; d < dim; ++d) ga[d] += sigma * gc[dim * l + d];
+        }
+        for (int a = 0; a < nen; ++a) {
+          const double *dN = g.dNdx[q][a];
+          S &Rmu = R[(nen * j + a) * 2 + 1];
+          for (int d = 0; d < dim; ++d) Rmu -= w * dN[d] * ga[d];
         }
       }
     }

@@ -37,6 +37,7 @@ struct sp_output_s {
   int dim; /**< the mesh's: cells.csv has z on a 3D one */
   int named; /**< the scene names its cells: cells.csv and divisions.csv
                   end with name columns */
+  int adhesion; /**< the scene has adhesion: energy.csv ends with its column */
   int n_fields, cap_fields;
   sp_output_field *fields; /**< each fields file written, in write order */
 };
@@ -287,11 +288,14 @@ static const char sp_divisions_header_3d[] =
  *  names and the lineage table's share of the first daughter. */
 static const char sp_cells_names[] = ",name";
 static const char sp_divisions_names[] = ",parent_name,first_name,second_name,fraction";
+/** What adhesion adds to energy.csv: its part of the energy (in the total). */
+static const char sp_energy_adhesion[] = ",adhesion";
 
 /** Open @p dir's logs for a mesh of dimension @p dim: new ones
  *  (@p resume_step < 0), or the existing ones cut back to the rows of steps
  *  <= @p resume_step and appended to. */
-static int output_open(const char *dir, int dim, int named, int resume_step, sp_output *out) {
+static int output_open(const char *dir, int dim, int flags, int resume_step, sp_output *out) {
+  const int named = (flags & SP_OUTPUT_NAMED) != 0;
   *out = NULL;
   SP_CALL(sp_mkdir_p(dir));
   struct sp_output_s *o;
@@ -299,6 +303,7 @@ static int output_open(const char *dir, int dim, int named, int resume_step, sp_
   o->dir = sp_strfmt("%s", dir);
   o->dim = dim;
   o->named = named;
+  o->adhesion = (flags & SP_OUTPUT_ADHESION) != 0;
   o->energy_path = sp_strfmt("%s/%s", dir, sp_logs[0].name);
   o->cells_path = sp_strfmt("%s/%s", dir, sp_logs[1].name);
   o->divisions_path = sp_strfmt("%s/%s", dir, sp_logs[2].name);
@@ -316,8 +321,10 @@ static int output_open(const char *dir, int dim, int named, int resume_step, sp_
                          : i == 2     ? sp_divisions_header_3d
                                       : sp_logs[i].header;
     char *named_header =
-        sp_strfmt("%s%s", header, !named ? "" : i == 1 ? sp_cells_names
-                                             : i == 2 ? sp_divisions_names : "");
+        sp_strfmt("%s%s", header, i == 0 ? (o->adhesion ? sp_energy_adhesion : "")
+                                  : !named ? ""
+                                  : i == 1 ? sp_cells_names
+                                           : sp_divisions_names);
     if (!named_header && rc == SP_OK)
       rc = sp_error_set(SP_ERR_MEMORY, "out of memory for the header of '%s'", paths[i]);
     if (rc == SP_OK) rc = sp_log_open(paths[i], exists ? NULL : named_header, files[i]);
@@ -333,9 +340,9 @@ static int output_open(const char *dir, int dim, int named, int resume_step, sp_
 
 int sp_output_open(const char *dir, sp_output *out) { return output_open(dir, 2, 0, -1, out); }
 
-int sp_output_open_dim(const char *dir, int dim, int named, sp_output *out) {
+int sp_output_open_dim(const char *dir, int dim, int flags, sp_output *out) {
   SP_CHECK(dim == 2 || dim == 3, SP_ERR_INTERNAL, "output: dimension %d", dim);
-  return output_open(dir, dim, named, -1, out);
+  return output_open(dir, dim, flags, -1, out);
 }
 
 int sp_output_log_open(const char *dir, const char *name, const char *header,
@@ -355,20 +362,23 @@ int sp_output_log_done(FILE *f, const char *path, int printed) {
 int sp_output_energy(sp_output out, int step, double t, double dt,
                      int newton_its, int n_cells, const sp_energy_parts *parts,
                      double shape, const sp_step_costs *seconds) {
-  sp_energy_parts p = {0, 0, 0, 0};
+  sp_energy_parts p = {0, 0, 0, 0, 0};
   if (parts) p = *parts;
   sp_step_costs w = {.error_estimate = -1};
   if (seconds) w = *seconds;
   double total = p.bulk + p.gradient + p.repulsion + p.buffer + shape;
+  if (out->adhesion) total += p.adhesion;
   /* %.17g: every double prints to a string that reads back bit-exact. */
   int n = fprintf(out->energy,
                   "%d,%.17g,%.17g,%d,%d,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
-                  "%.4g,%.4g,%.4g,%.4g,%.4g,%d,%ld,%d,%d,%d,%.4g,%ld,%.6g\n",
+                  "%.4g,%.4g,%.4g,%.4g,%.4g,%d,%ld,%d,%d,%d,%.4g,%ld,%.6g",
                   step, t, dt, newton_its, n_cells, total, p.bulk, p.gradient,
                   p.repulsion, p.buffer, shape, w.step, w.assembly, w.factorisation,
                   w.solves, w.supports, w.support_changed, w.unknowns, w.factorisations,
                   w.failed_attempts, w.failed_factorisations, w.residual_rise, w.linear_its,
                   w.error_estimate);
+  if (n >= 0 && out->adhesion) n = fprintf(out->energy, ",%.17g", p.adhesion);
+  if (n >= 0) n = fprintf(out->energy, "\n");
   return sp_log_done(out->energy, out->energy_path, n);
 }
 
@@ -865,10 +875,10 @@ int sp_output_fields_pvtu(sp_output out, const sp_layout *layout, int step, doub
   return sp_pvd_write(out);
 }
 
-int sp_output_resume(const char *dir, int dim, int step, int named, int n_fields,
+int sp_output_resume(const char *dir, int dim, int step, int flags, int n_fields,
                      const sp_output_field *fields, sp_output *out) {
   SP_CHECK(dim == 2 || dim == 3, SP_ERR_INTERNAL, "output: dimension %d", dim);
-  SP_CALL(output_open(dir, dim, named, step, out));
+  SP_CALL(output_open(dir, dim, flags, step, out));
   for (int i = 0; i < n_fields; ++i)
     if (fields[i].step <= step) {
       int rc = sp_fields_record(*out, fields[i].step, fields[i].t, fields[i].pvtu);

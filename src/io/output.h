@@ -25,12 +25,20 @@ typedef struct sp_output_s *sp_output;
  *         (a 2D mesh's). */
 int sp_output_open(const char *dir, sp_output *out);
 
+/** What a scene adds to the logs (sp_output_open_dim's @p flags). */
+enum {
+  SP_OUTPUT_NAMED = 1,   /**< the scene names its cells */
+  SP_OUTPUT_ADHESION = 2 /**< the scene has adhesion */
+};
+
 /** @brief sp_output_open for a mesh of dimension @p dim (2 or 3): on a 3D
  *         mesh cells.csv is step,t,cell,mass,xc,yc,zc,I1,I2,I3,long_x,long_y,
- *         long_z,core_mass,volume (docs/3d.md); @p named (the scene names
- *         its cells): cells.csv ends with a name column, divisions.csv with
- *         parent_name,first_name,second_name,fraction. */
-int sp_output_open_dim(const char *dir, int dim, int named, sp_output *out);
+ *         long_z,core_mass,volume (docs/3d.md); with SP_OUTPUT_NAMED in
+ *         @p flags (the scene names its cells) cells.csv ends with a name
+ *         column, divisions.csv with parent_name,first_name,second_name,
+ *         fraction; with SP_OUTPUT_ADHESION energy.csv ends with the
+ *         adhesion part of the energy (in its total). */
+int sp_output_open_dim(const char *dir, int dim, int flags, sp_output *out);
 
 /** One fields file of fields.pvd: fields_<step>.vtu, or .pvtu of pieces. */
 typedef struct {
@@ -46,7 +54,7 @@ typedef struct {
  *        @p step. Logs that do not exist are started with their headers
  *        (cells.csv's for a mesh of dimension @p dim, as sp_output_open_dim).
  */
-int sp_output_resume(const char *dir, int dim, int step, int named, int n_fields,
+int sp_output_resume(const char *dir, int dim, int step, int flags, int n_fields,
                      const sp_output_field *fields, sp_output *out);
 
 /** @brief The fields files written so far, in order (a checkpoint saves

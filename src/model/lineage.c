@@ -21,6 +21,15 @@
 int sp_lineage_from_scene(const sp_scene *scene, sp_lineage *out) {
   *out = (sp_lineage){0};
   for (int i = 0; i < scene->n_cells; ++i) out->named |= scene->cells[i].name[0] != '\0';
+  if (scene->n_adhesion > 0) {
+    SP_ALLOC(out->pair, scene->n_adhesion);
+    out->n_pairs = scene->n_adhesion;
+    for (int i = 0; i < out->n_pairs; ++i) {
+      memcpy(out->pair[i].cell, scene->adhesion[i].cell, sizeof out->pair[i].cell);
+      memcpy(out->pair[i].other, scene->adhesion[i].other, sizeof out->pair[i].other);
+      out->pair[i].sigma = scene->adhesion[i].sigma;
+    }
+  }
   if (scene->n_lineage == 0) return SP_OK;
   SP_ALLOC(out->entry, scene->n_lineage);
   out->n = scene->n_lineage;
@@ -50,6 +59,7 @@ int sp_lineage_from_scene(const sp_scene *scene, sp_lineage *out) {
 
 void sp_lineage_free(sp_lineage *lineage) {
   free(lineage->entry);
+  free(lineage->pair);
   *lineage = (sp_lineage){0};
 }
 

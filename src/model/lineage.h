@@ -43,14 +43,23 @@ typedef struct {
   double direction[3]; /**< axis fixed: the unit normal */
 } sp_lineage_entry;
 
+/** A named pair with an adhesion coefficient of its own (adhesion.h). */
+typedef struct {
+  sp_cell_name cell, other;
+  double sigma;
+} sp_lineage_pair;
+
 /** The table. */
 typedef struct {
   int n;
   sp_lineage_entry *entry;
   int named; /**< the scene names its cells: the CSV logs get name columns */
+  int n_pairs;           /**< the scene's adhesion pairs (0: none) */
+  sp_lineage_pair *pair;
 } sp_lineage;
 
-/** @brief The table of a checked scene (an empty one when it has none). */
+/** @brief The table of a checked scene (an empty one when it has none),
+ *         with its named adhesion pairs. */
 int sp_lineage_from_scene(const sp_scene *scene, sp_lineage *out);
 
 /** @brief Free the table (it is empty after). */

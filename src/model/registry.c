@@ -29,6 +29,7 @@ int sp_registry_resize(sp_registry *reg, int n) {
   SP_CALL(resize_array((void **)&reg->shape, sizeof *reg->shape, n_old, n));
   SP_CALL(resize_array((void **)&reg->name, sizeof *reg->name, n_old, n));
   SP_CALL(resize_array((void **)&reg->cut_normal, sizeof *reg->cut_normal, n_old, n));
+  SP_CALL(resize_array((void **)&reg->sister, sizeof *reg->sister, n_old, n));
   reg->n = n;
   return SP_OK;
 }
@@ -46,5 +47,6 @@ void sp_registry_free(sp_registry *reg) {
   free(reg->divisions);
   free(reg->name);
   free(reg->cut_normal);
+  free(reg->sister);
   *reg = (sp_registry){0};
 }

@@ -5,7 +5,7 @@
  *        change, resize.h, at set-up, division and checkpoint restore).
  *        Per cell: its observables, its birth (time, mass, reference
  *        moments, generation), its name and the normal of the cut that
- *        made it, its source switch, whether a due division
+ *        made it, its sister, its source switch, whether a due division
  *        was skipped, whether it divided this step; and the per-cell
  *        scratch of a step (the observables of the step's end, the core
  *        masses before it, the shape coefficients), so a step allocates
@@ -35,6 +35,10 @@ typedef struct {
   double (*cut_normal)[3]; /**< the unit normal of the cut that made it
                                 (0 for an initial cell): the axis rule
                                 perpendicular turns it */
+  int *sister;            /**< its sister's index + 1 (the other daughter of
+                               the division that made it), 0: none (an
+                               initial cell, or the sister divided since):
+                               adhesion.h */
   /* a step's scratch (contents undefined between steps) */
   sp_cell_obs *obs_new;   /**< the observables of the step's end */
   double *core_mass_old;  /**< the core masses before the step */

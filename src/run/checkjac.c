@@ -42,15 +42,19 @@ static int check_state(checkjac *c, const char *what, double t, double *worst_ha
   /* At the start of a step: state_old = state, Jacobian at the state. */
   memcpy(run->buf.state_old, run->state, 2 * (size_t)run->layout->n_pairs * sizeof(double));
   static const char *rows[] = {"all terms", "lambda = 0", "lambda_b = 0",
-                               "lambda = lambda_b = 0"};
+                               "lambda = lambda_b = 0", "no adhesion"};
+  /* a scene with adhesion: also without it (its blocks alone are the
+   * difference between the first row and this one) */
+  const int n_rows = run->opt.model.adhesion ? 5 : 4;
   if (run->rank == 0)
     printf("\n%s (t = %.6g):\n  %-24s %12s %12s %12s\n", what, t, "terms", "hand vs ad",
            "ad vs fd", "hand vs fd");
-  for (int r = 0; r < 4; ++r) {
+  for (int r = 0; r < n_rows; ++r) {
     sp_step_data data = {.dt = run->opt.time.dt.dt, .model = run->opt.model,
                          .state_old = run->buf.state_old, .source = NULL, .shape = NULL};
     if (r == 1 || r == 3) data.model.lambda = 0.0;
     if (r == 2 || r == 3) data.model.lambda_b = 0.0;
+    if (r == 4) data.model.adhesion = NULL;
     double hand_ad, ad_fd, hand_fd;
     SP_CALL(compare(c, &data, SP_SOLVER_JAC_HAND, SP_SOLVER_JAC_AD, &hand_ad));
     SP_CALL(compare(c, &data, SP_SOLVER_JAC_AD, SP_SOLVER_JAC_FD, &ad_fd));

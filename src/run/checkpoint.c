@@ -316,6 +316,7 @@ static int write_state(hid_t f, const sp_run *run) {
   bad |= put_array(f, "/cells/divided_now", H5T_NATIVE_UCHAR, run->cells.divided_now, nc);
   bad |= put_array(f, "/cells/name", H5T_NATIVE_CHAR, run->cells.name, nc * SP_CELL_NAME_MAX);
   bad |= put_array(f, "/cells/cut_normal", H5T_NATIVE_DOUBLE, run->cells.cut_normal, 3 * nc);
+  bad |= put_array(f, "/cells/sister", H5T_NATIVE_INT, run->cells.sister, nc);
   bad |= put_members(f, "/controller", &run->dtc, controller_members, N_OF(controller_members));
   bad |= H5LTset_attribute_double(f, "/controller", "event_dt", &run->dtc.event_dt, 1) < 0;
   bad |= put_members(f, "/summary", run->mon.sum, summary_members, N_OF(summary_members));
@@ -785,6 +786,11 @@ static int read_registry(const sp_checkpoint ck, sp_registry *cells, int nc, int
   for (int k = 0; k < nc; ++k) cells->name[k][SP_CELL_NAME_MAX - 1] = '\0';
   SP_CALL(get_array(ck, "/cells/cut_normal", H5T_NATIVE_DOUBLE, cells->cut_normal,
                     3 * (size_t)nc));
+  /* a file written before sisters were kept: none known */
+  if (H5LTpath_valid(ck->file, "/cells/sister", 1) > 0)
+    SP_CALL(get_array(ck, "/cells/sister", H5T_NATIVE_INT, cells->sister, nc));
+  for (int k = 0; k < nc; ++k)
+    if (cells->sister[k] < 0 || cells->sister[k] > nc) cells->sister[k] = 0;
   return SP_OK;
 }
 
@@ -810,6 +816,7 @@ int sp_checkpoint_restore(const sp_checkpoint ck, sp_run *run, int as_initial,
   if (as_initial) return SP_OK; /* the caller makes the registry of a new run */
   SP_CALL(read_history(ck, &run->hist, n_values));
   SP_CALL(read_registry(ck, &run->cells, nc, run->mesh->dim));
+  SP_CALL(sp_run_adhesion_update(run)); /* (the sisters read) */
   /* the controller, the counters, step and time */
   SP_CALL(get_members(ck->file, ck->path, "/controller", &run->dtc, controller_members,
                       N_OF(controller_members)));

@@ -49,6 +49,15 @@ int sp_events_on_output_time(const sp_run *run, double t) {
   return k > 0 && fabs(t - k * every) <= 1e-12 * run->opt.time.t_end;
 }
 
+/** The model of the first step's convexity bound: with adhesion the
+ *  gradient energy's coefficient is at least kappa minus the largest sum
+ *  of a cell's partners' sigma on an element (docs/model.md, "Adhesion"). */
+static sp_model_params convexity_model(const sp_run *run) {
+  sp_model_params m = run->opt.model;
+  m.kappa -= run->adhesion_sum;
+  return m;
+}
+
 /** The starting step after this step's @p n_divided divisions: the
  *  convexity bound over the daughters' own nodes (c >=
  *  division.observe_threshold), not the mesh's worst overlap; the
@@ -59,7 +68,8 @@ static int first_dt_after_divisions(const sp_run *run, int n_divided, double *dt
   SP_ALLOC(daughters, (size_t)run->layout->n_cells);
   for (int i = 0; i < n_divided; ++i)
     daughters[run->cells.divisions[i].parent] = daughters[run->cells.divisions[i].child] = 1;
-  *dt = fmax(sp_scheme_first_dt_cells(run->layout, run->state, &run->opt.model,
+  const sp_model_params model = convexity_model(run);
+  *dt = fmax(sp_scheme_first_dt_cells(run->layout, run->state, &model,
                                       fmin(p->dt, p->dt_max), daughters,
                                       run->opt.division.observe_threshold),
              p->dt_min);
@@ -69,8 +79,8 @@ static int first_dt_after_divisions(const sp_run *run, int n_divided, double *dt
 
 double sp_events_first_dt(const sp_run *run) {
   const sp_dt_params *p = &run->opt.time.dt;
-  const double dt =
-      sp_scheme_first_dt(run->layout, run->state, &run->opt.model, fmin(p->dt, p->dt_max));
+  const sp_model_params model = convexity_model(run);
+  const double dt = sp_scheme_first_dt(run->layout, run->state, &model, fmin(p->dt, p->dt_max));
   return fmax(dt, p->dt_min);
 }
 
@@ -209,6 +219,12 @@ static int divide_cell(sp_run *run, int parent, const sp_lineage_entry *e,
   sp_lineage_daughter_names(e, parent_name, cells->name[parent], cells->name[child]);
   memcpy(cells->cut_normal[parent], normal, sizeof normal);
   memcpy(cells->cut_normal[child], normal, sizeof normal);
+  /* the daughters are sisters; the parent's sister is no one's now */
+  for (int k = 0; k < n; ++k)
+    if (cells->sister[k] == parent + 1) cells->sister[k] = 0;
+  cells->sister[parent] = child + 1;
+  cells->sister[child] = parent + 1;
+  SP_CALL(sp_agree(run->agree_comm, sp_run_adhesion_update(run)));
   const int dim = run->mesh->dim;
   /* 2D: the angle of the division line, the normal turned by -90 degrees
    * (+0, not -0, in divisions.csv) */

@@ -157,16 +157,22 @@ static int write_last_state(sp_run *run, int rc) {
                       sp_error_message());
 }
 
+/** What the scene adds to the logs (output.h). */
+static int output_flags(const sp_run *run) {
+  return (run->lineage.named ? SP_OUTPUT_NAMED : 0) |
+         (sp_adhesion_on(&run->opt.adhesion) ? SP_OUTPUT_ADHESION : 0);
+}
+
 int sp_monitor_open(sp_run *run) {
   sp_monitor *mon = &run->mon;
   int rc = SP_OK;
   if (run->rank == 0) {
     if (run->restarted) { /* the logs cut back to the checkpoint's step */
       sp_checkpoint_remove_after(mon->out_dir, run->step);
-      rc = sp_output_resume(mon->out_dir, run->mesh->dim, run->step, run->lineage.named,
+      rc = sp_output_resume(mon->out_dir, run->mesh->dim, run->step, output_flags(run),
                             mon->n_fields, mon->fields, &mon->output);
     } else {
-      rc = sp_output_open_dim(mon->out_dir, run->mesh->dim, run->lineage.named, &mon->output);
+      rc = sp_output_open_dim(mon->out_dir, run->mesh->dim, output_flags(run), &mon->output);
     }
     if (rc == SP_OK)
       rc = sp_output_units_write(mon->out_dir, run->mesh->dim, &run->opt.output.units);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "base/agree.h"
+#include "model/adhesion.h"
 #include "public/error.h"
 #include "mesh/partition.h"
 #include "run/solver_status.h"
@@ -113,9 +114,26 @@ int sp_run_resize(sp_run *run, sp_layout *layout, double *state, sp_history_move
   run->state = state;
   SP_CALL(alloc_step_buffers(run));
   SP_CALL(sp_registry_resize(&run->cells, layout->n_cells));
-  SP_CALL(sp_agree(run->agree_comm, SP_OK)); /* attaching is collective */
+  /* (every rank has the same registry and layout: the same verdict) */
+  SP_CALL(sp_agree(run->agree_comm, sp_run_adhesion_update(run))); /* attaching is collective */
   SP_CALL(pick_linear(run));
   SP_CALL(sp_solver_attach(run->solver, run->mesh, run->layout));
   count_bytes(run); /* (after the attach: the slot table is built) */
   return SP_OK;
+}
+
+int sp_run_adhesion_update(sp_run *run) {
+  if (!sp_adhesion_on(&run->opt.adhesion)) return SP_OK;
+  const int n = run->cells.n;
+  double *table = realloc(run->adhesion, sizeof(double) * ((size_t)n * n + 1));
+  SP_CHECK(table, SP_ERR_MEMORY, "out of memory for the adhesion table of %d cells", n);
+  run->adhesion = table;
+  sp_adhesion_table(&run->opt.adhesion, n, run->cells.sister,
+                    (const sp_cell_name *)run->cells.name, table);
+  run->opt.model.adhesion = table;
+  run->opt.model.adhesion_cells = n;
+  const sp_slots *slots;
+  SP_CALL(sp_layout_slots(run->layout, run->mesh, &slots));
+  return sp_adhesion_check(&run->opt.adhesion, table, n, slots, run->opt.model.kappa,
+                           (const sp_cell_name *)run->cells.name, &run->adhesion_sum);
 }

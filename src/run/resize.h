@@ -37,6 +37,18 @@ typedef enum {
  */
 int sp_run_resize(sp_run *run, sp_layout *layout, double *state, sp_history_move how);
 
+/**
+ * @brief The run's adhesion table (adhesion.h) for its cells and their
+ *        sisters as the registry has them, pointed to by opt.model, and the
+ *        bound on its layout (SP_ERR_INPUT naming the keys when a cell's
+ *        partners on an element sum to kappa or more). Nothing without
+ *        adhesion. Called by sp_run_resize, and again where the registry's
+ *        sisters change (a division, a checkpoint restore). Sets
+ *        run->adhesion_sum, the largest sum of a cell's partners' sigma on
+ *        an element.
+ */
+int sp_run_adhesion_update(sp_run *run);
+
 /** @brief Hand the solver a mesh and layout (its maps and graph are rebuilt
  *         when the layout changed). Collective on the solver's ranks. */
 int sp_solver_attach(sp_solver solver, const sp_mesh *mesh, const sp_layout *layout);

@@ -5,7 +5,7 @@
 #include "run/solver_status.h"
 
 double sp_energy_fields(const sp_energy_parts *p) {
-  return p->bulk + p->gradient + p->repulsion + p->buffer;
+  return p->bulk + p->gradient + p->repulsion + p->buffer + p->adhesion;
 }
 
 int sp_run_energy(sp_run *run, sp_energy_parts *parts) {

@@ -14,7 +14,8 @@
 extern "C" {
 #endif
 
-/** @brief The sum of the field energy's parts (without the shape term). */
+/** @brief The sum of the field energy's parts (without the shape term;
+ *         with adhesion). */
 double sp_energy_fields(const sp_energy_parts *parts);
 
 /** @brief The field energy of the run's state (collective: agreed first). */

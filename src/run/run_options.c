@@ -100,6 +100,8 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
   opt->linear_auto = (sp_run_linear_auto){.on = scene->solver.linear == SP_LINEAR_AUTO,
                                           .unknowns = scene->solver.auto_unknowns,
                                           .krylov_tol = scene->solver.krylov_tol};
+  opt->adhesion = (sp_adhesion_params){.sisters = scene->model.adhesion_sisters,
+                                       .non_sisters = scene->model.adhesion_non_sisters};
   sp_dt_params_from_scene(scene, &opt->time.dt);
   opt->time.scheme = tc->scheme == SP_TIME_BDF2 ? SP_SCHEME_BDF2 : SP_SCHEME_BE;
   opt->time.adaptive = tc->control == SP_CONTROL_ADAPTIVE;

@@ -10,6 +10,7 @@
 #ifndef SP_RUN_OPTIONS_H
 #define SP_RUN_OPTIONS_H
 
+#include "model/adhesion.h"
 #include "model/division.h"
 #include "time/dt_control.h"
 #include "mesh/mesh.h"
@@ -82,7 +83,8 @@ typedef struct {
 
 /** Everything a run reads of its scene after set-up. */
 typedef struct {
-  sp_model_params model;
+  sp_model_params model;  /**< (model.adhesion: the run's table, resize.h) */
+  sp_adhesion_params adhesion;
   sp_solver_options solver;
   sp_run_linear_auto linear_auto;
   sp_run_time time;

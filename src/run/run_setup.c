@@ -183,6 +183,8 @@ static int initial_run(sp_run *run, const sp_scene *scene, MPI_Comm comm,
 static int setup(sp_run *run, const sp_scene *scene, MPI_Comm comm, const sp_run_start *start) {
   int n;
   SP_CALL(sp_lineage_from_scene(scene, &run->lineage));
+  run->opt.adhesion.n_pairs = run->lineage.n_pairs; /* (the lineage owns them) */
+  run->opt.adhesion.pair = run->lineage.pair;
   SP_CALL(initial_run(run, scene, comm, start, &n));
   /* use_initial_mass: the first initial cell's birth mass (the same for a
    * run continued from a checkpoint, whose scene has the same cells) */
@@ -226,6 +228,8 @@ void sp_run_free(sp_run *run) {
   run->buf = (sp_step_buffers){0};
   sp_history_free(&run->hist);
   sp_registry_free(&run->cells);
+  free(run->adhesion);
+  run->adhesion = NULL;
   sp_lineage_free(&run->lineage);
   sp_support_destroy(&run->support);
 }

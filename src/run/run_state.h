@@ -105,6 +105,11 @@ typedef struct {
   int marked_step;      /**< the step whose start dtc_step_start and the
                              solver's carry mark hold (0: none yet) */
   sp_registry cells;    /**< the cell registry */
+  double *adhesion;     /**< the cells' adhesion table (n_cells^2, from the
+                             registry's sisters; NULL without adhesion):
+                             opt.model.adhesion points to it (resize.h) */
+  double adhesion_sum;  /**< the largest sum of a cell's partners' sigma on
+                             an element of the layout (0 without adhesion) */
   int n_max;            /**< N_max */
   sp_lineage lineage;   /**< the lineage table (lineage.h; from the scene) */
   int restarted;        /**< 1: continued from a checkpoint (not as initial) */

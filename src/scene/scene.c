@@ -59,7 +59,9 @@ typedef struct {
 static const sp_sequence sp_sequences[SP_N_SEQUENCES] = {
     {offsetof(sp_scene, cells), offsetof(sp_scene, n_cells), sizeof(sp_scene_cell), "a cell"},
     {offsetof(sp_scene, lineage), offsetof(sp_scene, n_lineage), sizeof(sp_scene_lineage),
-     "a lineage entry"}};
+     "a lineage entry"},
+    {offsetof(sp_scene, adhesion), offsetof(sp_scene, n_adhesion), sizeof(sp_scene_adhesion),
+     "an adhesion pair"}};
 
 /** The sequence of a sequence section. */
 static const sp_sequence *sequence_of(sp_section section) {
@@ -848,6 +850,7 @@ void sp_scene_destroy(sp_scene **scene) {
   if (!scene || !*scene) return;
   free((*scene)->cells);
   free((*scene)->lineage);
+  free((*scene)->adhesion);
   free(*scene);
   *scene = NULL;
 }

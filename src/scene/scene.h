@@ -62,6 +62,8 @@ typedef struct {
   double lambda;   /**< pair repulsion */
   double lambda_b; /**< buffer-ring penalty */
   double mobility; /**< M */
+  double adhesion_sisters;     /**< sigma of two sisters (docs/model.md, "Adhesion") */
+  double adhesion_non_sisters; /**< sigma of any other two cells */
 } sp_scene_model;
 
 /** How dt is chosen (src/time/dt_control.h). */
@@ -126,6 +128,14 @@ typedef struct {
   sp_axis_kind axis;             /**< the cut's normal */
   double direction[3]; /**< axis fixed: the normal (x, y, z; NaN: not given) */
 } sp_scene_lineage;
+
+/** One named pair of the adhesion table: its sigma, instead of the sisters'
+ *  or non-sisters' (src/model/adhesion.h). */
+typedef struct {
+  char cell[SP_CELL_NAME_MAX];  /**< one cell's name */
+  char other[SP_CELL_NAME_MAX]; /**< the other's */
+  double sigma;                 /**< their adhesion coefficient */
+} sp_scene_adhesion;
 
 /** @brief The semi-axis of @p cell along coordinate @p d (0, 1, 2): its
  *         semi_x, semi_y or semi_z if given, else its radius. */
@@ -316,6 +326,8 @@ typedef struct sp_scene {
   sp_scene_cell *cells;
   int n_lineage;       /**< entries of the lineage table (0: none) */
   sp_scene_lineage *lineage;
+  int n_adhesion;      /**< named pairs with their own adhesion (0: none) */
+  sp_scene_adhesion *adhesion;
 } sp_scene;
 
 /**

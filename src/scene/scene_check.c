@@ -140,6 +140,22 @@ static int check_flatten_key(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
+/** model.adhesion_*: each below kappa, which bounds the gradient energy of
+ *  a pair alone (docs/model.md, "Adhesion"); the sum over a cell's partners
+ *  on an element is checked by the run on each layout (model/adhesion.h). */
+static int check_adhesion_keys(const sp_scene *scene, const char *file) {
+  const sp_scene_model *m = &scene->model;
+  SP_CHECK(m->adhesion_sisters < m->kappa, SP_ERR_INPUT,
+           "%s: model.adhesion_sisters: expected a number < model.kappa = %.15g (the "
+           "gradient energy is bounded below only then), got %.15g",
+           file, m->kappa, m->adhesion_sisters);
+  SP_CHECK(m->adhesion_non_sisters < m->kappa, SP_ERR_INPUT,
+           "%s: model.adhesion_non_sisters: expected a number < model.kappa = %.15g (the "
+           "gradient energy is bounded below only then), got %.15g",
+           file, m->kappa, m->adhesion_non_sisters);
+  return SP_OK;
+}
+
 static int check_time_and_mesh(const sp_scene *scene, const char *file) {
   const sp_scene_time *t = &scene->time;
   SP_CHECK(t->dt_min <= t->dt, SP_ERR_INPUT,
@@ -545,6 +561,37 @@ static int check_lineage(const sp_scene *scene, const char *file) {
   return SP_OK;
 }
 
+/** The named pairs of the adhesion table: names known, two cells, each pair
+ *  once, sigma below kappa. */
+static int check_adhesion_pairs(const sp_scene *scene, const char *file) {
+  const char *which;
+  for (int i = 0; i < scene->n_adhesion; ++i) {
+    const sp_scene_adhesion *a = &scene->adhesion[i];
+    const char *name[2] = {a->cell, a->other}, *key[2] = {"cell", "other"};
+    for (int k = 0; k < 2; ++k)
+      SP_CHECK(initial_named(scene, name[k]) >= 0 || daughter_entry(scene, name[k], 0, &which) >= 0,
+               SP_ERR_INPUT,
+               "%s: adhesion[%d].%s: unknown name '%s': expected an initial cell's name "
+               "(cells[i].name) or a daughter of a lineage entry (first, second)",
+               file, i, key[k], name[k]);
+    SP_CHECK(strcmp(a->cell, a->other) != 0, SP_ERR_INPUT,
+             "%s: adhesion[%d].other: expected a name other than cell's, got '%s' twice",
+             file, i, a->other);
+    for (int j = 0; j < i; ++j) {
+      const sp_scene_adhesion *b = &scene->adhesion[j];
+      SP_CHECK(!((strcmp(a->cell, b->cell) == 0 && strcmp(a->other, b->other) == 0) ||
+                 (strcmp(a->cell, b->other) == 0 && strcmp(a->other, b->cell) == 0)),
+               SP_ERR_INPUT, "%s: adhesion[%d]: the pair '%s', '%s' has a sigma already "
+               "(adhesion[%d])", file, i, a->cell, a->other, j);
+    }
+    SP_CHECK(a->sigma < scene->model.kappa, SP_ERR_INPUT,
+             "%s: adhesion[%d].sigma: expected a number < model.kappa = %.15g (the gradient "
+             "energy is bounded below only then), got %.15g",
+             file, i, scene->model.kappa, a->sigma);
+  }
+  return SP_OK;
+}
+
 /** The initial layout (every cell on every node: a run starts with it, also
  *  before cutting local supports) must be numberable by ints and the solver's
  *  32-bit global ids; checked here, before anything that large is allocated. */
@@ -600,9 +647,11 @@ int sp_scene_check_cell_count(const sp_scene *scene, int n_cells, const char *ce
 
 int sp_scene_validate(const sp_scene *scene, const char *where) {
   SP_CALL(check_time_and_mesh(scene, where));
+  SP_CALL(check_adhesion_keys(scene, where));
   SP_CALL(check_3d(scene, where));
   SP_CALL(check_initial(scene, where));
   SP_CALL(check_cells(scene, where));
   SP_CALL(check_lineage(scene, where));
+  SP_CALL(check_adhesion_pairs(scene, where));
   return check_sizes(scene, scene->n_cells, "cells", where);
 }

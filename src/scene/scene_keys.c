@@ -18,7 +18,7 @@
 /** The sections' names, by sp_section. */
 const char *const sp_section_names[SP_N_SECTIONS] = {
     "mesh", "model", "time", "noise", "solver", "output", "division", "source",
-    "layout", "shape", "initial", "cells", "lineage"};
+    "layout", "shape", "initial", "cells", "lineage", "adhesion"};
 
 static const char *const sp_key_type_names[] = {"float", "int", "uint", "bool",
                                                  "enum",  "path", "name"};
@@ -140,6 +140,11 @@ _Static_assert(sizeof(sp_linear_kind) == sizeof(int), "enum size");
    ENUM_MEMBER_OFFSET(sp_scene_lineage, member), def, 0, UNBOUNDED, UNBOUNDED, \
    words, CYAML_ARRAY_LEN(words), unit, meaning}
 
+#define ADHESION_FLOAT_REQUIRED(name, member, lo, hi, unit, meaning)          \
+  {SP_SEC_ADHESION, name, SP_KEY_FLOAT,                                        \
+   MEMBER_OFFSET(sp_scene_adhesion, member, double), 0.0, 1, lo, hi, NULL, 0,  \
+   unit, meaning}
+
 /* Units: L = the model's length unit, T = its time unit, E = its energy per
  * unit area (the energy density of Pi); "-" = dimensionless. Defaults are
  * the paper's values (table 1) where the paper has one. */
@@ -205,6 +210,16 @@ const sp_key sp_keys[] = {
               "buffer penalty lambda_b c_k^2 in the buffer zone"),
     KEY_FLOAT(SP_SEC_MODEL, "mobility", model.mobility, 1.0, ABOVE(0.0),
               UNBOUNDED, "L^2/(E T)", "Cahn-Hilliard mobility M"),
+    KEY_FLOAT(SP_SEC_MODEL, "adhesion_sisters", model.adhesion_sisters, 0.0, AT_LEAST(0.0),
+              UNBOUNDED, "E L^2",
+              "adhesion sigma of two sisters (the daughters of one division): energy "
+              "sigma int grad c_k . grad c_l, negative where they touch (docs/model.md, "
+              "\"Adhesion\"); on every element, a cell's sigma summed over the other cells "
+              "there must stay below kappa; 0: none"),
+    KEY_FLOAT(SP_SEC_MODEL, "adhesion_non_sisters", model.adhesion_non_sisters, 0.0,
+              AT_LEAST(0.0), UNBOUNDED, "E L^2",
+              "adhesion sigma of two cells that are not sisters (initial cells, cousins, "
+              "a cell and its aunt); as adhesion_sisters"),
     /* time */
     KEY_ENUM(SP_SEC_TIME, "control", time.control, SP_CONTROL_ADAPTIVE,
              sp_control_words, "-",
@@ -630,6 +645,15 @@ const sp_key sp_keys[] = {
                   "axis fixed: y component of the cut's normal"),
     LINEAGE_FLOAT("direction_z", direction[2], NAN, UNBOUNDED, UNBOUNDED, "-",
                   "axis fixed: z component of the cut's normal (3D meshes only)"),
+    /* adhesion: one mapping per named pair with a sigma of its own (src/model/adhesion.h) */
+    NAME_KEY(SP_SEC_ADHESION, sp_scene_adhesion, "cell", cell, 1,
+             "one cell of the pair: an initial cell's name or a daughter of a lineage entry"),
+    NAME_KEY(SP_SEC_ADHESION, sp_scene_adhesion, "other", other, 1,
+             "the other cell of the pair (as cell)"),
+    ADHESION_FLOAT_REQUIRED("sigma", sigma, AT_LEAST(0.0), UNBOUNDED, "E L^2",
+                            "the pair's adhesion sigma while both cells exist, instead of "
+                            "model.adhesion_sisters or model.adhesion_non_sisters (0: none "
+                            "between them); below kappa"),
 };
 
 _Static_assert(sizeof sp_keys / sizeof sp_keys[0] == SP_N_KEYS,

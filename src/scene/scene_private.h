@@ -32,6 +32,7 @@ typedef enum {
   SP_SEC_INITIAL,
   SP_SEC_CELLS, /**< a sequence of cell mappings, not a mapping of scalars */
   SP_SEC_LINEAGE, /**< a sequence of lineage entries, like cells */
+  SP_SEC_ADHESION, /**< a sequence of named pairs' adhesion */
   SP_N_SECTIONS
 } sp_section;
 
@@ -42,7 +43,7 @@ typedef enum {
 
 extern const char *const sp_section_names[SP_N_SECTIONS];
 
-/** 1 if @p section is a sequence (cells, lineage), 0 if a mapping. */
+/** 1 if @p section is a sequence (cells, lineage, adhesion), 0 if a mapping. */
 static inline int is_sequence(sp_section section) { return section >= SP_N_MAPPINGS; }
 
 /** Scalar type of a key as the user sees it. */
@@ -86,7 +87,7 @@ typedef struct {
 
 /** The number of rows of sp_keys[] (scene_keys.c checks it at compile
  *  time: a key added there is counted here too). */
-enum { SP_N_KEYS = 133 };
+enum { SP_N_KEYS = 138 };
 
 /** The key table, in the order of the documentation (scene_keys.c). */
 extern const sp_key sp_keys[SP_N_KEYS];
