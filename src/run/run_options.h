@@ -10,6 +10,7 @@
 #ifndef SP_RUN_OPTIONS_H
 #define SP_RUN_OPTIONS_H
 
+#include "model/contacts.h"
 #include "model/division.h"
 #include "time/dt_control.h"
 #include "mesh/mesh.h"
@@ -66,6 +67,8 @@ typedef struct {
   int picture_width;
   int contacts;            /**< contacts.csv and contacts_<step>.png */
   double contact_threshold; /**< contacts.h's threshold */
+  sp_contacts_measure contact_measure; /**< output.contact_measure */
+  double contact_level;    /**< output.contact_level */
   int timings;             /**< energy.csv's wall-clock columns */
   int checkpoint_every;
   double checkpoint_seconds;
