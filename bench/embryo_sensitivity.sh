@@ -16,8 +16,8 @@
 #            are symmetric under y -> -y but for the noise, so A >= 0 and
 #            B of either sign cover the cases.
 # Printed per run (Markdown rows): the four cells' centres (um), each
-# pair's contact as a fraction of the smaller cell's diffuse surface
-# (contacts.csv), and which pairs touch by the gap between their c >= 1/2
+# pair's contact as a fraction of the smaller cell's surface
+# (contacts.csv; the membranes under the default output.contact_measure), and which pairs touch by the gap between their c >= 1/2
 # sets (bench/embryo_table.py's, from the last fields_<step>.vtu): a pair
 # touches when the gap is below GAP_UM (3 um; pressed cells read 1.1 to
 # 2.9 um, a pair with a cell between them 4.8 um or more, three-cell

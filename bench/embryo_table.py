@@ -15,8 +15,9 @@ units the scene names: um, min) and prints, in Markdown:
     CShaper atlas's volume and fraction (Cao et al. 2020, as quoted in
     docs/embryo.md);
   - the contacts of those stages: each pair's contact (contacts.csv) in the
-    scene's unit and as a fraction of each of the two cells' diffuse
-    surfaces, beside the published ones: PUBLISHED holds the contact
+    scene's unit and as a fraction of each of the two cells' surfaces (their
+    membranes under the default output.contact_measure; docs/model.md,
+    "Contacts"), beside the published ones: PUBLISHED holds the contact
     fractions that can be cited (none found: docs/embryo.md, "The C. elegans 8-cell scene", says what was searched; the column prints "-"),
     and TOUCHES whether the pair touches in the embryo where a source says
     so (the 4-cell "diamond": ABa does not touch P2, the other five pairs
@@ -27,9 +28,9 @@ units the scene names: um, min) and prints, in Markdown:
     the smallest distance between a mesh node where c_k >= 1/2 and one where
     c_l >= 1/2. Two cells pressed together have a gap of about one element
     (their c = 1/2 surfaces meet between nodes); cells with a third one
-    between them, its width. A test of touching that does not read the
-    diffuse fields' gradients far from the membranes, as the contact
-    measure does (docs/embryo.md, "The C. elegans 8-cell scene").
+    between them, its width. A test of touching from the nodes alone, beside
+    contacts.csv's (docs/model.md, "Contacts"; docs/embryo.md, "The C.
+    elegans 8-cell scene").
 """
 import base64
 import csv

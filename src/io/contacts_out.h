@@ -21,8 +21,9 @@ typedef struct {
 } sp_contacts_log;
 
 /** contacts.csv's header: a cell row (other = 0) holds the cell's total
- *  contact, volume (c >= 1/2; an area in 2D), diffuse surface and free
- *  surface; a pair row (cell < other) its contact, the rest empty. */
+ *  contact, volume (c >= 1/2; an area in 2D), surface (its membrane, or
+ *  its diffuse surface: contacts.h's measures) and free surface; a pair
+ *  row (cell < other) its contact, the rest empty. */
 #define SP_CONTACTS_HEADER "step,t,cell,other,contact,volume,surface,free_surface"
 
 /** @brief Open @p dir/contacts.csv: new with its header (@p resume_step

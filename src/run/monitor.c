@@ -37,7 +37,8 @@ static int measure_contacts(sp_run *run) {
   SP_ALLOC(first_node, (size_t)run->n_ranks + 1);
   sp_partition_ranges(run->layout, run->n_ranks, first_node);
   int rc = sp_contacts_integrate(run->mesh, run->layout, run->state, first_node[run->rank],
-                                 first_node[run->rank + 1], &run->mon.contacts);
+                                 first_node[run->rank + 1], run->opt.output.contact_measure,
+                                 run->opt.output.contact_level, &run->mon.contacts);
   free(first_node);
   SP_CALL(sp_agree(run->agree_comm, rc)); /* a collective follows */
   return sp_contacts_reduce(run->agree_comm, &run->mon.contacts);

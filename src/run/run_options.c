@@ -133,6 +133,10 @@ void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
                                 .pictures = out->pictures, .picture_width = out->picture_width,
                                 .contacts = out->contacts,
                                 .contact_threshold = out->contact_threshold,
+                                .contact_measure = out->contact_measure == SP_CONTACT_OVERLAP
+                                                       ? SP_CONTACTS_OVERLAP
+                                                       : SP_CONTACTS_ISOSURFACE,
+                                .contact_level = out->contact_level,
                                 .timings = out->timings,
                                 .checkpoint_every = out->checkpoint_every,
                                 .checkpoint_seconds = out->checkpoint_seconds,

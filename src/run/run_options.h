@@ -11,6 +11,7 @@
 #define SP_RUN_OPTIONS_H
 
 #include "model/adhesion.h"
+#include "model/contacts.h"
 #include "model/division.h"
 #include "time/dt_control.h"
 #include "mesh/mesh.h"
@@ -67,6 +68,8 @@ typedef struct {
   int picture_width;
   int contacts;            /**< contacts.csv and contacts_<step>.png */
   double contact_threshold; /**< contacts.h's threshold */
+  sp_contacts_measure contact_measure; /**< output.contact_measure */
+  double contact_level;    /**< output.contact_level */
   int timings;             /**< energy.csv's wall-clock columns */
   int checkpoint_every;
   double checkpoint_seconds;

@@ -197,6 +197,9 @@ typedef struct {
   int refine;                  /**< SuperLU_DIST: iterative refinement */
 } sp_scene_solver;
 
+/** How contacts are measured (contacts.h's sp_contacts_measure). */
+typedef enum { SP_CONTACT_ISOSURFACE = 0, SP_CONTACT_OVERLAP = 1 } sp_contact_measure_kind;
+
 /** output: what is written and when. */
 typedef struct {
   int every;          /**< fields and pictures every this many steps */
@@ -204,6 +207,8 @@ typedef struct {
   int picture_width;  /**< picture width in pixels */
   int contacts;       /**< 1: write contacts.csv (and contacts_<step>.png) */
   double contact_threshold; /**< in contact: A_kl >= this x min(S_k, S_l) */
+  sp_contact_measure_kind contact_measure; /**< isosurface or overlap */
+  double contact_level; /**< isosurface: the other field's level theta */
   double interval;    /**< also write at multiples of this time (0: off);
                            steps land on those times */
   int timings;        /**< 1: energy.csv's wall-clock columns hold the

@@ -71,6 +71,8 @@ static const cyaml_strval_t sp_axis_words[] = {
     {"long", SP_AXIS_LONG}, {"fixed", SP_AXIS_FIXED}, {"perpendicular", SP_AXIS_PERPENDICULAR}};
 static const cyaml_strval_t sp_indicator_words[] = {
     {"extrapolated", SP_INDICATOR_EXTRAPOLATED}, {"previous", SP_INDICATOR_PREVIOUS}};
+static const cyaml_strval_t sp_contact_measure_words[] = {
+    {"isosurface", SP_CONTACT_ISOSURFACE}, {"overlap", SP_CONTACT_OVERLAP}};
 static const cyaml_strval_t sp_support_words[] = {
     {"auto", SP_SUPPORT_AUTO}, {"full", SP_SUPPORT_FULL}, {"local", SP_SUPPORT_LOCAL}};
 /* The YAML 1.1 booleans; the first word of each value is the one printed. */
@@ -387,14 +389,27 @@ const sp_key sp_keys[] = {
             AT_LEAST(64), AT_MOST(8192), "px", "picture width"),
     KEY_BOOL(SP_SEC_OUTPUT, "contacts", output.contacts, 1, "-",
              "write contacts.csv (every step, as cells.csv: each cell's volume, "
-             "diffuse and free surface, each pair in contact with its contact "
+             "surface and free surface, each pair in contact with its contact "
              "area, a length in 2D) and, with pictures, contacts_<step>.png "
              "(docs/model.md, \"Contacts\")"),
+    KEY_ENUM(SP_SEC_OUTPUT, "contact_measure", output.contact_measure, SP_CONTACT_ISOSURFACE,
+             sp_contact_measure_words, "-",
+             "isosurface: a cell's surface is its membrane c = 1/2, a pair's contact "
+             "the part of each membrane where the other cell's field is at least "
+             "contact_level (zero for membranes further apart than "
+             "d ln((1 - level) / level)); overlap: the diffuse surface (the integral "
+             "of the gradient's norm) and the overlap of two cells' interface "
+             "densities, which reads every pair within a few d as touching "
+             "(docs/model.md, \"Contacts\")"),
+    KEY_FLOAT(SP_SEC_OUTPUT, "contact_level", output.contact_level, 0.05,
+              ABOVE(0.0), AT_MOST(0.5), "-",
+              "contact_measure isosurface: the part of a cell's membrane where another "
+              "cell's field is at least this is in contact with it"),
     KEY_FLOAT(SP_SEC_OUTPUT, "contact_threshold", output.contact_threshold, 0.01,
               AT_LEAST(0.0), AT_MOST(1.0), "-",
               "two cells are in contact (a row of contacts.csv, an edge of the "
-              "contact graph) when their measured contact is at least this "
-              "fraction of the smaller of their two diffuse surfaces"),
+              "contact graph) when their measured contact is above 0 and at least this "
+              "fraction of the smaller of their two surfaces"),
     KEY_FLOAT(SP_SEC_OUTPUT, "interval", output.interval, 0.0, AT_LEAST(0.0),
               UNBOUNDED, "T",
               "also write fields and pictures at every multiple of this time "

@@ -87,7 +87,7 @@ typedef struct {
 
 /** The number of rows of sp_keys[] (scene_keys.c checks it at compile
  *  time: a key added there is counted here too). */
-enum { SP_N_KEYS = 138 };
+enum { SP_N_KEYS = 140 };
 
 /** The key table, in the order of the documentation (scene_keys.c). */
 extern const sp_key sp_keys[SP_N_KEYS];
