@@ -153,13 +153,53 @@ static double piece_measure(int dim, int n, const double x[4][SP_Q1_MAX_DIM], co
   return 0.5 * sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
 }
 
+/** Element @p e's membrane pieces (slots @p s0 .. @p s1 - 1, their nodal
+ *  values @p value and maxima @p largest): each slot's piece of c_k = 1/2
+ *  into S_k, and its part where another slot's field reaches @p level
+ *  into A_kl. */
+static void add_membranes(const sp_mesh *mesh, int e, const sp_slots *t, int n, int64_t s0,
+                          int64_t s1, const double *value, const double *largest, double level,
+                          sp_contacts *out) {
+  const int dim = mesh->dim, nen = mesh->nodes_per_elem;
+  const int n_simplices = dim == 3 ? 6 : 2;
+  double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
+  sp_mesh_elem_xy(mesh, e, xe);
+  for (int64_t s = s0; s < s1; ++s) {
+    const double *vk = value + (size_t)nen * (s - s0);
+    const int k = t->slot_cell[s];
+    for (int q = 0; q < n_simplices; ++q) {
+      const int *vertex = dim == 3 ? hex_tetrahedra[q] : quad_triangles[q];
+      double x[4][SP_Q1_MAX_DIM], f[4];
+      for (int a = 0; a <= dim; ++a) {
+        for (int d = 0; d < dim; ++d) x[a][d] = xe[vertex[a]][d];
+        f[a] = vk[vertex[a]] - 0.5;
+      }
+      membrane_piece p;
+      membrane_piece_of(dim, x, f, &p);
+      if (p.n == 0) continue;
+      out->surface[k] += piece_measure(dim, p.n, p.x, NULL);
+      for (int64_t r = s0; r < s1; ++r) {
+        if (r == s || largest[r - s0] < level) continue;
+        const double *vl = value + (size_t)nen * (r - s0);
+        double g[4];
+        for (int i = 0; i < p.n; ++i) {
+          const double ga = vl[vertex[p.from[i]]], gb = vl[vertex[p.to[i]]];
+          g[i] = ga + p.t[i] * (gb - ga) - level;
+        }
+        const int l = t->slot_cell[r];
+        out->overlap[k < l ? sp_contacts_pair(n, k, l) : sp_contacts_pair(n, l, k)] +=
+            0.5 * piece_measure(dim, p.n, p.x, g);
+      }
+    }
+  }
+}
+
 /** The isosurface measure: S_k = |{c_k = 1/2}| and
  *  A_kl = (|S_k and {c_l >= level}| + |S_l and {c_k >= level}|) / 2. */
 static int integrate_isosurface(const sp_mesh *mesh, const sp_slots *t, int n,
                                 const double *state, int first_node, int end_node, double level,
                                 sp_contacts *out) {
-  const int dim = mesh->dim, nen = mesh->nodes_per_elem;
-  const int n_simplices = dim == 3 ? 6 : 2;
+  const int nen = mesh->nodes_per_elem;
   double *value, *largest; /* each slot's nodal values on an element, and their maximum */
   SP_ALLOC(value, (size_t)nen * ((size_t)n + 1));
   largest = malloc(sizeof(double) * ((size_t)n + 1));
@@ -184,36 +224,7 @@ static int integrate_isosurface(const sp_mesh *mesh, const sp_slots *t, int n,
       crossed |= lo < 0.5 && hi >= 0.5;
     }
     if (!crossed) continue;
-    double xe[SP_Q1_MAX_NODES][SP_Q1_MAX_DIM];
-    sp_mesh_elem_xy(mesh, e, xe);
-    for (int64_t s = s0; s < s1; ++s) {
-      const double *vk = value + (size_t)nen * (s - s0);
-      const int k = t->slot_cell[s];
-      for (int q = 0; q < n_simplices; ++q) {
-        const int *vertex = dim == 3 ? hex_tetrahedra[q] : quad_triangles[q];
-        double x[4][SP_Q1_MAX_DIM], f[4];
-        for (int a = 0; a <= dim; ++a) {
-          for (int d = 0; d < dim; ++d) x[a][d] = xe[vertex[a]][d];
-          f[a] = vk[vertex[a]] - 0.5;
-        }
-        membrane_piece p;
-        membrane_piece_of(dim, x, f, &p);
-        if (p.n == 0) continue;
-        out->surface[k] += piece_measure(dim, p.n, p.x, NULL);
-        for (int64_t r = s0; r < s1; ++r) {
-          if (r == s || largest[r - s0] < level) continue;
-          const double *vl = value + (size_t)nen * (r - s0);
-          double g[4];
-          for (int i = 0; i < p.n; ++i) {
-            const double ga = vl[vertex[p.from[i]]], gb = vl[vertex[p.to[i]]];
-            g[i] = ga + p.t[i] * (gb - ga) - level;
-          }
-          const int l = t->slot_cell[r];
-          out->overlap[k < l ? sp_contacts_pair(n, k, l) : sp_contacts_pair(n, l, k)] +=
-              0.5 * piece_measure(dim, p.n, p.x, g);
-        }
-      }
-    }
+    add_membranes(mesh, e, t, n, s0, s1, value, largest, level, out);
   }
   free(value);
   free(largest);

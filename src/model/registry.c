@@ -17,19 +17,27 @@ static int resize_array(void **ptr, size_t elem, int n_old, int n) {
 int sp_registry_resize(sp_registry *reg, int n) {
   const int n_old = reg->obs ? reg->n : 0;
   if (reg->obs && n == n_old) return SP_OK; /* (a support change: the arrays stay put) */
-  SP_CALL(resize_array((void **)&reg->obs, sizeof *reg->obs, n_old, n));
-  SP_CALL(resize_array((void **)&reg->birth, sizeof *reg->birth, n_old, n));
-  SP_CALL(resize_array((void **)&reg->source_on, sizeof *reg->source_on, n_old, n));
-  SP_CALL(resize_array((void **)&reg->division_skipped, sizeof *reg->division_skipped, n_old, n));
-  SP_CALL(resize_array((void **)&reg->divided_now, sizeof *reg->divided_now, n_old, n));
-  SP_CALL(resize_array((void **)&reg->obs_new, sizeof *reg->obs_new, n_old, n));
-  SP_CALL(resize_array((void **)&reg->core_mass_old, sizeof *reg->core_mass_old, n_old, n));
-  SP_CALL(resize_array((void **)&reg->core_mass, sizeof *reg->core_mass, n_old, n));
-  SP_CALL(resize_array((void **)&reg->divisions, sizeof *reg->divisions, n_old, n));
-  SP_CALL(resize_array((void **)&reg->shape, sizeof *reg->shape, n_old, n));
-  SP_CALL(resize_array((void **)&reg->name, sizeof *reg->name, n_old, n));
-  SP_CALL(resize_array((void **)&reg->cut_normal, sizeof *reg->cut_normal, n_old, n));
-  SP_CALL(resize_array((void **)&reg->sister, sizeof *reg->sister, n_old, n));
+  /* every per-cell array, in one table */
+  const struct {
+    void **array;
+    size_t size;
+  } arrays[] = {
+      {(void **)&reg->obs, sizeof *reg->obs},
+      {(void **)&reg->birth, sizeof *reg->birth},
+      {(void **)&reg->source_on, sizeof *reg->source_on},
+      {(void **)&reg->division_skipped, sizeof *reg->division_skipped},
+      {(void **)&reg->divided_now, sizeof *reg->divided_now},
+      {(void **)&reg->obs_new, sizeof *reg->obs_new},
+      {(void **)&reg->core_mass_old, sizeof *reg->core_mass_old},
+      {(void **)&reg->core_mass, sizeof *reg->core_mass},
+      {(void **)&reg->divisions, sizeof *reg->divisions},
+      {(void **)&reg->shape, sizeof *reg->shape},
+      {(void **)&reg->name, sizeof *reg->name},
+      {(void **)&reg->cut_normal, sizeof *reg->cut_normal},
+      {(void **)&reg->sister, sizeof *reg->sister},
+  };
+  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
+    SP_CALL(resize_array(arrays[i].array, arrays[i].size, n_old, n));
   reg->n = n;
   return SP_OK;
 }
