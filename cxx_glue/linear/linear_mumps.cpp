@@ -57,6 +57,7 @@ class MumpsSolver final : public LinearSolver {
     id_.job = kJobInit;
     dmumps_c(&id_);
     started_ = id_.SP_INFOG(1) >= 0;
+    if (started_) controls();  // quiet from here on, its end included
   }
 
   ~MumpsSolver() override {

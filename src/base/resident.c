@@ -5,16 +5,19 @@
 #include <string.h>
 
 int sp_resident_mb(double *now, double *peak) {
-  *now = *peak = 0.0;
-  FILE *f = fopen("/proc/self/status", "r");
-  if (!f) return -1;
-  char line[256];
+  double kb_now = 0.0, kb_peak = 0.0;
   int found = 0;
-  while (fgets(line, sizeof line, f)) {
-    long kb;
-    if (sscanf(line, "VmRSS: %ld kB", &kb) == 1) *now = kb / 1024.0, found |= 1;
-    else if (sscanf(line, "VmHWM: %ld kB", &kb) == 1) *peak = kb / 1024.0, found |= 2;
+  FILE *f = fopen("/proc/self/status", "r");
+  if (f) {
+    char line[256];
+    while (fgets(line, sizeof line, f)) {
+      long kb;
+      if (sscanf(line, "VmRSS: %ld kB", &kb) == 1) kb_now = (double)kb, found |= 1;
+      else if (sscanf(line, "VmHWM: %ld kB", &kb) == 1) kb_peak = (double)kb, found |= 2;
+    }
+    fclose(f);
   }
-  fclose(f);
+  if (now) *now = kb_now / 1024.0;
+  if (peak) *peak = kb_peak / 1024.0;
   return found == 3 ? 0 : -1;
 }

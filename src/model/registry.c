@@ -14,14 +14,17 @@ static int resize_array(void **ptr, size_t elem, int n_old, int n) {
   return SP_OK;
 }
 
-int sp_registry_resize(sp_registry *reg, int n) {
-  const int n_old = reg->obs ? reg->n : 0;
-  if (reg->obs && n == n_old) return SP_OK; /* (a support change: the arrays stay put) */
-  /* every per-cell array, in one table */
-  const struct {
-    void **array;
-    size_t size;
-  } arrays[] = {
+/** Every per-cell array of the registry with its element size: the one
+ *  list that resizing and freeing read. */
+typedef struct {
+  void **array;
+  size_t size;
+} per_cell_array;
+
+#define SP_REGISTRY_ARRAYS 13
+
+static void per_cell_arrays(sp_registry *reg, per_cell_array out[SP_REGISTRY_ARRAYS]) {
+  const per_cell_array arrays[] = {
       {(void **)&reg->obs, sizeof *reg->obs},
       {(void **)&reg->birth, sizeof *reg->birth},
       {(void **)&reg->source_on, sizeof *reg->source_on},
@@ -36,25 +39,24 @@ int sp_registry_resize(sp_registry *reg, int n) {
       {(void **)&reg->cut_normal, sizeof *reg->cut_normal},
       {(void **)&reg->sister, sizeof *reg->sister},
   };
-  for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
+  _Static_assert(sizeof arrays / sizeof *arrays == SP_REGISTRY_ARRAYS, "one entry per array");
+  memcpy(out, arrays, sizeof arrays);
+}
+
+int sp_registry_resize(sp_registry *reg, int n) {
+  const int n_old = reg->obs ? reg->n : 0;
+  if (reg->obs && n == n_old) return SP_OK; /* (a support change: the arrays stay put) */
+  per_cell_array arrays[SP_REGISTRY_ARRAYS];
+  per_cell_arrays(reg, arrays);
+  for (size_t i = 0; i < SP_REGISTRY_ARRAYS; ++i)
     SP_CALL(resize_array(arrays[i].array, arrays[i].size, n_old, n));
   reg->n = n;
   return SP_OK;
 }
 
 void sp_registry_free(sp_registry *reg) {
-  free(reg->obs);
-  free(reg->birth);
-  free(reg->source_on);
-  free(reg->division_skipped);
-  free(reg->divided_now);
-  free(reg->obs_new);
-  free(reg->core_mass_old);
-  free(reg->core_mass);
-  free(reg->shape);
-  free(reg->divisions);
-  free(reg->name);
-  free(reg->cut_normal);
-  free(reg->sister);
+  per_cell_array arrays[SP_REGISTRY_ARRAYS];
+  per_cell_arrays(reg, arrays);
+  for (size_t i = 0; i < SP_REGISTRY_ARRAYS; ++i) free(*arrays[i].array);
   *reg = (sp_registry){0};
 }

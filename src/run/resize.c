@@ -64,13 +64,12 @@ static int alloc_step_buffers(sp_run *run) {
  *  states where the scheme, the estimate or the predictor keeps them) and
  *  the step's buffers. */
 static void count_bytes(sp_run *run) {
-  const sp_run_options *o = &run->opt;
   const double pair = 8.0 * (double)run->layout->n_pairs; /* one double per pair */
-  const int history = o->time.adaptive || o->time.scheme == SP_SCHEME_BDF2 ||
-                      o->time.predictor_linear;
-  const double state = 2 * pair /* state */ + 2 * pair + pair /* state_old, source */ +
-                       (o->time.scheme == SP_SCHEME_BDF2 ? 2 * pair : 0) +
-                       (o->time.adaptive ? 2 * pair : 0) + (history ? 4 * pair : 0);
+  const sp_step_buffers *b = &run->buf;
+  const double *buffers[] = {b->state_old, b->state_eff, b->scratch};
+  double state = 2 * pair /* the state */ + (b->source ? pair : 0);
+  for (size_t i = 0; i < sizeof buffers / sizeof *buffers; ++i) state += buffers[i] ? 2 * pair : 0;
+  if (sp_run_keeps_history(&run->opt)) state += 4 * pair; /* (allocated at the first push) */
   double mesh = sp_mesh_bytes(run->mesh) + sp_layout_bytes(run->layout);
   if (run->support) mesh += sp_support_bytes(run->support);
   run->bytes_mesh = fmax(run->bytes_mesh, mesh);

@@ -91,6 +91,10 @@ void sp_dt_params_from_scene(const sp_scene *scene, sp_dt_params *p) {
       .event_growth = tc->event_growth, .event_steps = tc->event_steps};
 }
 
+int sp_run_keeps_history(const sp_run_options *opt) {
+  return opt->time.adaptive || opt->time.scheme == SP_SCHEME_BDF2 || opt->time.predictor_linear;
+}
+
 void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt) {
   const sp_scene_time *tc = &scene->time;
   const sp_scene_division *dv = &scene->division;

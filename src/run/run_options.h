@@ -99,6 +99,10 @@ typedef struct {
 /** @brief The run's options from @p scene (a checked scene: no errors). */
 void sp_run_options_from_scene(const sp_scene *scene, sp_run_options *opt);
 
+/** @brief Whether a run keeps its past states: the BDF2 scheme, the error
+ *         estimate and the linear predictor read them. */
+int sp_run_keeps_history(const sp_run_options *opt);
+
 /** @brief The mesh a scene describes. */
 int sp_mesh_from_scene(const sp_scene *scene, sp_mesh **out);
 /** @brief The mesh nodes from which `auto` picks gmres_amg in 3D (between

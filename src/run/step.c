@@ -217,7 +217,7 @@ int sp_step_complete(sp_run *run, const sp_step_attempt *a) {
                                           (size_t)run->layout->n_pairs, o->time.rtol,
                                           o->time.atol));
   /* the past states: for the scheme, the error estimate, the predictor */
-  if (o->time.adaptive || o->time.scheme == SP_SCHEME_BDF2 || o->time.predictor_linear)
+  if (sp_run_keeps_history(o))
     SP_CALL(sp_history_push(&run->hist, run->buf.state_old, a->dt, n_values));
   /* the core masses before the step, for crossing-safe criteria */
   for (int k = 0; k < n_cells; ++k) cells->core_mass_old[k] = cells->obs[k].mass_core;

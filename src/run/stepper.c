@@ -56,8 +56,8 @@ int sp_stepper_run_from(const sp_scene *scene, const sp_run_start *start, const 
                         sp_run_summary *summary) {
   sp_run_summary sum = {0};
   const double t0 = sp_wall_clock();
-  double mb_before, peak_before;
-  sp_resident_mb(&mb_before, &peak_before);
+  double mb_before;
+  sp_resident_mb(&mb_before, NULL);
   sp_run run = {.mon = {.sum = &sum, .out_dir = out_dir, .on_step = on_step,
                         .on_step_user = user, .t_start = t0, .t_checkpoint = t0}};
   int rc = sp_run_setup(&run, scene, comm, start);
