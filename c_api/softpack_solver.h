@@ -379,6 +379,11 @@ const char *sp_solver_trilinos_version(void);
  */
 int sp_solver_linear_backend(int linear, const char **backend);
 
+/** @brief 1 when the glue's dgemm_ hands products with one column to the
+ *         BLAS's dgemv_ (cxx_glue/base/blas_forward.cpp), 0 when
+ *         SOFTPACK_GEMM_FORWARD=0 turned it off. */
+int sp_solver_gemm_forward(void);
+
 /** @brief The message of the last failed call on @p s. */
 const char *sp_solver_last_error(sp_solver s);
 

@@ -19,20 +19,24 @@ const char *sp_version(void) { return SP_VERSION; }
 const char *sp_build_type(void) { return SP_BUILD_TYPE; }
 
 /** The BLAS in use: the file that serves dgemm_ (Debian's alternatives
- *  resolved), and OpenBLAS' own description when it is loaded. */
+ *  resolved; the next after libsoftpack's own, which hands products with
+ *  one column to dgemv_), and OpenBLAS' own description when it is loaded. */
 static void print_blas(FILE *out) {
   char path[PATH_MAX] = "no dgemm_ loaded";
   Dl_info where;
-  void *dgemm = dlsym(RTLD_DEFAULT, "dgemm_");
+  void *dgemm = dlsym(RTLD_NEXT, "dgemm_");
   if (dgemm && dladdr(dgemm, &where) && where.dli_fname &&
       !realpath(where.dli_fname, path))
     snprintf(path, sizeof path, "%s", where.dli_fname);
   char *(*openblas_config)(void) = NULL;
   *(void **)&openblas_config = dlsym(RTLD_DEFAULT, "openblas_get_config");
+  const char *forward = sp_solver_gemm_forward()
+                            ? "one-column products through dgemv_"
+                            : "one-column products through dgemm_ (SOFTPACK_GEMM_FORWARD=0)";
   if (openblas_config)
-    fprintf(out, "BLAS: %s; dgemm_ from %s\n", openblas_config(), path);
+    fprintf(out, "BLAS: %s; dgemm_ from %s; %s\n", openblas_config(), path, forward);
   else
-    fprintf(out, "BLAS: dgemm_ from %s (not OpenBLAS)\n", path);
+    fprintf(out, "BLAS: dgemm_ from %s (not OpenBLAS); %s\n", path, forward);
 }
 
 void sp_build_info_print(FILE *out, MPI_Comm comm) {
