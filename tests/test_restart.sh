@@ -13,9 +13,10 @@
 #   inside a checkpoint write): the logs hold whole lines and the newest
 #   checkpoint is readable (the resumed run again equals the whole one);
 # - with a launcher (mpirun -np 2 ...): the same on two processes, and a
-#   checkpoint of one process resumed on two: the energies agree to 1e-9
-#   relative (Newton's tolerance is 1e-8 on the residual; the partition
-#   changes the rounding, not the steps);
+#   checkpoint of one process resumed on two, one of two resumed on one
+#   and on three: the energies agree to 1e-9 relative with the whole run's
+#   (Newton's tolerance is 1e-8 on the residual; the partition changes the
+#   rounding, not the steps);
 # - a continued run that changes the physics (--set model.kappa=...), and
 #   one from a truncated or a foreign checkpoint, are refused: exit 2, a
 #   message naming the key or the file, nothing in the directory changed.
@@ -197,23 +198,44 @@ for f in energy.csv cells.csv divisions.csv contacts.csv fields.pvd; do
   cmp -s "$work/whole_often/$f" "$work/often/$f" || fail "SIGKILL rounds: $f differs"
 done
 
-# several processes: a checkpoint of one process resumed on them
+# several processes: a checkpoint of one process resumed on them, and one
+# of the launcher's processes resumed on one process and on one more
+# process than the launcher's (mpiexec -n P ...: its third word)
 if [ ${#launch[@]} -gt 0 ]; then
+  energies_agree() { # DIR LABEL: the same steps as the whole run, energies to 1e-9 relative
+    awk -F, -v label="$2" 'NR == FNR { e[$1] = $6; t[$1] = $2; n = FNR; next }
+             FNR > 1 { m = FNR; d = ($6 - e[$1]) / e[$1]; if (d < 0) d = -d; if (d > worst) worst = d
+                       dt = $2 - t[$1]; if (dt < 0) dt = -dt; if (dt > tw) tw = dt }
+             END { printf "%s: %d and %d rows, largest relative energy difference %.2e, '\
+'largest time difference %.2e\n", label, n, m, worst, tw
+                   exit !(n == m && worst <= 1e-9 && tw <= 1e-12) }' \
+      "$work/whole/energy.csv" "$1/energy.csv" ||
+      fail "$2: the energies differ by more than 1e-9"
+  }
   mkdir -p "$work/serial"
   "$sp" run "$scene" --quiet --out "$work/serial" "${sets[@]}" --set output.checkpoint_keep=100 \
     > "$work/serial.log" 2>&1 || fail "the one-process run failed"
   ck=$(ls "$work/serial"/checkpoint_*.h5 | sed -n 3p)
   run "$work/serial" --restart "$ck" --set output.checkpoint_keep=100 ||
     fail "a one-process checkpoint resumed on ${launch[*]}: status $?"
-  # the same steps; energies to 1e-9 relative
-  awk -F, 'NR == FNR { e[$1] = $6; t[$1] = $2; n = FNR; next }
-           FNR > 1 { m = FNR; d = ($6 - e[$1]) / e[$1]; if (d < 0) d = -d; if (d > worst) worst = d
-                     dt = $2 - t[$1]; if (dt < 0) dt = -dt; if (dt > tw) tw = dt }
-           END { printf "one process resumed on several: %d and %d rows, largest relative energy '\
-'difference %.2e, largest time difference %.2e\n", n, m, worst, tw
-                 exit !(n == m && worst <= 1e-9 && tw <= 1e-12) }' \
-    "$work/whole/energy.csv" "$work/serial/energy.csv" ||
-    fail "one process resumed on several: the energies differ by more than 1e-9"
+  energies_agree "$work/serial" "one process resumed on ${launch[*]}"
+  if [[ ${#launch[@]} -ge 3 && ${launch[2]} =~ ^[0-9]+$ ]]; then
+    run "$work/ranks" --set output.checkpoint_keep=100 || fail "the run on ${launch[*]} failed"
+    ck_ranks=$(basename "$(ls "$work/ranks"/checkpoint_*.h5 | sed -n 3p)")
+    cp -r "$work/ranks" "$work/ranks_on_1"
+    "$sp" run "$scene" --quiet --out "$work/ranks_on_1" "${sets[@]}" \
+      --restart "$work/ranks_on_1/$ck_ranks" --set output.checkpoint_keep=100 \
+      > "$work/ranks_on_1.log" 2>&1 || fail "a checkpoint of ${launch[*]} resumed on one process: status $?"
+    energies_agree "$work/ranks_on_1" "${launch[2]} processes resumed on 1"
+    more=("${launch[@]}")
+    more[2]=$((launch[2] + 1))
+    cp -r "$work/ranks" "$work/ranks_on_more"
+    "${more[@]}" "$sp" run "$scene" --quiet --out "$work/ranks_on_more" "${sets[@]}" \
+      --restart "$work/ranks_on_more/$ck_ranks" --set output.checkpoint_keep=100 \
+      > "$work/ranks_on_more.log" 2>&1 ||
+      fail "a checkpoint of ${launch[*]} resumed on ${more[*]}: status $?"
+    energies_agree "$work/ranks_on_more" "${launch[2]} processes resumed on ${more[2]}"
+  fi
 fi
 
 # a continued run may not change the physics: refused, nothing changed
