@@ -4,8 +4,8 @@
 // right-hand side with DGEMM (N = 1), and so do Belos' inner products of
 // the Krylov basis against one vector. OpenBLAS 0.3.21 (Debian 12) runs
 // such a DGEMM as a general product: it first copies ("packs") the whole
-// factor block, which costs more than the product itself (a third of a
-// gmres_cells solve on 256^2 elements, docs/solvers.md). Later OpenBLAS
+// factor block, which costs more than the product itself (about a quarter
+// of a gmres_cells run on 256^2 elements, docs/solvers.md). Later OpenBLAS
 // versions hand these calls to DGEMV themselves; this file does the same
 // here: libsoftpack defines dgemm_, which every library the process loads
 // after it (MUMPS, Trilinos, SuperLU) calls; a product with one column of
