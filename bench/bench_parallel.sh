@@ -27,6 +27,7 @@
 # mumps"), BIN (default build/softpack), PINNED (above).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib.sh
 cases=("$@")
 [ ${#cases[@]} -eq 0 ] && cases=(r6 r7 paper16)
 read -r -a nps <<< "${NPS:-1 2}"
@@ -63,8 +64,7 @@ run() {
     awk -F, -v t0="$WINDOW_T0" 'NR > 1 && $2 > t0 { ++n; its += $4; s += $12; a += $13; f += $14; v += $15 }
       END { printf "%d %d %.3f %.3f %.3f %.3f ", n, its, s, a, f, v }' "$dir/out/energy.csv"
   else
-    sed -n 's/^softpack: \([0-9]*\) steps .* \([0-9]*\) Newton iterations.*, \([0-9.]*\) s (assembly \([0-9.]*\), factorisation \([0-9.]*\), solves \([0-9.]*\)).*/\1 \2 \3 \4 \5 \6/p' \
-      "$dir/log" | tr '\n' ' '
+    summary_phases "$dir/log" | tr '\n' ' '
   fi
   local unknowns
   unknowns=$(sed -n 's/.*at most \([0-9]*\) unknowns.*/\1/p' "$dir/log")

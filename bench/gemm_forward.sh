@@ -12,6 +12,7 @@
 #   ROUNDS (default 3), STEPS (default 4), NP (default 1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. bench/lib.sh
 build=${BUILD:-build}
 rounds=${ROUNDS:-3}
 steps=${STEPS:-4}
@@ -43,10 +44,7 @@ for c in "${cases[@]}"; do
       SOFTPACK_GEMM_FORWARD=$fwd "${launch[@]}" "$build/softpack" run "${scene[@]}" --out "$out" \
         --set time.max_steps="$steps" --set output.pictures=false --set output.every=1000000 \
         > "$out.log" 2>&1 || { echo "$c forward=$fwd failed:"; tail -3 "$out.log"; exit 1; }
-      # "... N.N s (assembly A, factorisation F, solves S); output in ..."
-      sed -n 's/.* \([0-9.]*\) s (assembly [0-9.]*, factorisation \([0-9.]*\), solves \([0-9.]*\)).*/\1 \2 \3/p' \
-        "$out.log" | tail -1 > "$out.t"
-      read -r s f v < "$out.t"
+      read -r _ _ s _ f v < <(summary_phases "$out.log")
       printf '%-9s %-8s %5d %10s %10s %10s\n' "$c" "$fwd" "$r" "$s" "$f" "$v"
       echo "$s $f $v" >> "$tmp/$c.$fwd.all"
     done

@@ -101,6 +101,13 @@ compare_runs() {
   cut -d, -f1-5 "$b/divisions.csv" | sed 's/^/  /'
 }
 
+# summary_phases LOG: from a run's closing line in LOG ("softpack: N steps
+# to ..., I Newton iterations (...), S s (assembly A, factorisation F,
+# solves V); ..."), "N I S A F V".
+summary_phases() {
+  sed -n 's/^softpack: \([0-9]*\) steps .* \([0-9]*\) Newton iterations.*, \([0-9.]*\) s (assembly \([0-9.]*\), factorisation \([0-9.]*\), solves \([0-9.]*\)).*/\1 \2 \3 \4 \5 \6/p' "$1"
+}
+
 # summary_wall RUN FILE: the wall seconds ab_runs recorded for RUN in its
 # summary FILE.
 summary_wall() {
